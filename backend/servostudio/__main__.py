@@ -1,0 +1,5 @@
+"""Allow ``python -m servostudio``."""
+
+from servostudio.cli import main
+
+raise SystemExit(main())

@@ -1,0 +1,1 @@
+"""api layer (see servostudio/__init__.py)."""

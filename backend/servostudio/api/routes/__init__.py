@@ -1,0 +1,1 @@
+"""api/routes layer (see servostudio/__init__.py)."""

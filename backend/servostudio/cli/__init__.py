@@ -1,0 +1,41 @@
+"""Command line: ``servostudio <command> …``.
+
+Every command prints JSON on stdout (or runs a server) and exits non-zero on failure,
+so scripts can chain them.
+"""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(prog="servostudio", description=__doc__.splitlines()[0])
+    commands = parser.add_subparsers(dest="command", required=True)
+    _add_serve(commands)
+    return parser
+
+
+def _add_serve(commands: argparse._SubParsersAction) -> None:
+
+    serve = commands.add_parser("serve", help="start the communication server and the browser UI")
+    serve.add_argument("--host", default="127.0.0.1", help="address to bind (default: 127.0.0.1)")
+    serve.add_argument("--port", type=int, default=8000, help="TCP port (default: 8000)")
+    serve.add_argument("--projects", type=Path, default=Path("projects"), help="project store directory")
+    serve.set_defaults(handler=_serve)
+
+
+def _serve(args: argparse.Namespace) -> int:
+    import uvicorn
+
+    from servostudio.api.app import Settings, create_app
+
+    app = create_app(Settings(projects_dir=args.projects))
+    uvicorn.run(app, host=args.host, port=args.port, log_level="info")
+    return 0
+
+
+def main(argv: list[str] | None = None) -> int:
+    args = build_parser().parse_args(argv)
+    return args.handler(args)
