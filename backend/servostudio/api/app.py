@@ -14,7 +14,9 @@ from fastapi.responses import FileResponse, HTMLResponse
 from fastapi.staticfiles import StaticFiles
 
 from servostudio import __version__
-from servostudio.api.routes import health
+from servostudio.api.routes import dictionaries, health
+from servostudio.od import BUILTIN_EDS_DIR, EdsLibrary
+from servostudio.od.library import DEFAULT_USER_EDS_DIR
 
 STATIC_DIR = Path(__file__).resolve().parent.parent / "static"
 
@@ -25,6 +27,7 @@ class Settings:
 
     projects_dir: Path = field(default_factory=lambda: Path("projects"))
     static_dir: Path = STATIC_DIR
+    user_eds_dir: Path = DEFAULT_USER_EDS_DIR
 
 
 def create_app(settings: Settings | None = None) -> FastAPI:
@@ -35,7 +38,9 @@ def create_app(settings: Settings | None = None) -> FastAPI:
         description="Communication server of Servo Studio: buses, drives, parameters, projects.",
     )
     app.state.settings = settings
+    app.state.eds_library = EdsLibrary(BUILTIN_EDS_DIR, settings.user_eds_dir)
     app.include_router(health.router, prefix="/api")
+    app.include_router(dictionaries.router, prefix="/api")
     _mount_ui(app, settings.static_dir)
     return app
 

@@ -7,18 +7,22 @@ so scripts can chain them.
 from __future__ import annotations
 
 import argparse
+import sys
 from pathlib import Path
+
+from servostudio.cli import eds
+from servostudio.cli.output import CommandError
 
 
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="servostudio", description=__doc__.splitlines()[0])
     commands = parser.add_subparsers(dest="command", required=True)
     _add_serve(commands)
+    eds.register(commands)
     return parser
 
 
 def _add_serve(commands: argparse._SubParsersAction) -> None:
-
     serve = commands.add_parser("serve", help="start the communication server and the browser UI")
     serve.add_argument("--host", default="127.0.0.1", help="address to bind (default: 127.0.0.1)")
     serve.add_argument("--port", type=int, default=8000, help="TCP port (default: 8000)")
@@ -38,4 +42,8 @@ def _serve(args: argparse.Namespace) -> int:
 
 def main(argv: list[str] | None = None) -> int:
     args = build_parser().parse_args(argv)
-    return args.handler(args)
+    try:
+        return args.handler(args)
+    except CommandError as error:
+        print(f"error: {error}", file=sys.stderr)
+        return error.exit_code

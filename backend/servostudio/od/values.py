@@ -1,0 +1,89 @@
+"""Parsing of the value texts found in EDS files (DefaultValue, LowLimit, HighLimit) per CiA 306.
+
+- Integers: decimal (`-12`), hexadecimal (`0x1F`), octal with a leading zero (`017`), optional sign.
+- `$NODEID` terms (integer types only, DefaultValue only): `$NODEID`, `$NODEID+0x180`, `0x180+$NODEID`
+  (case-insensitive). The constant part is returned together with a flag.
+- REAL32/REAL64: a hexadecimal text is the IEEE-754 bit pattern (what lely's dcf-tools expects, e.g. `0x3F800000`
+  is 1.0); any other text is a decimal number (`1.5`, `-2e-3`).
+- VISIBLE_STRING / UNICODE_STRING: the text itself. OCTET_STRING / DOMAIN: hexadecimal digits, two per byte
+  (whitespace ignored), e.g. `0102AB`.
+"""
+
+from __future__ import annotations
+
+import re
+import struct
+
+from servostudio.od.datatypes import DataType
+
+_NODE_ID = re.compile(r"^\s*\$nodeid\s*(?:\+\s*(?P<after>.+?))?\s*$|^\s*(?P<before>.+?)\s*\+\s*\$nodeid\s*$", re.I)
+
+
+class ValueSyntaxError(ValueError):
+    """A value text cannot be read; the message is the reason, without location."""
+
+
+def parse_integer(text: str) -> int:
+    """Decimal, 0x-hexadecimal or 0-octal integer with an optional sign."""
+    body = text.strip()
+    sign = 1
+    if body and body[0] in "+-":
+        sign = -1 if body[0] == "-" else 1
+        body = body[1:].strip()
+    try:
+        if body.lower().startswith("0x"):
+            return sign * int(body[2:], 16)
+        if len(body) > 1 and body.startswith("0"):
+            return sign * int(body[1:], 8)
+        if body.isdigit():
+            return sign * int(body, 10)
+    except ValueError:
+        pass
+    raise ValueSyntaxError(f"{text!r} is not an integer (decimal, 0x hexadecimal or 0 octal)")
+
+
+def parse_value(data_type: DataType, text: str, allow_node_id: bool = False) -> tuple[int | float | str | bytes, bool]:
+    """Read `text` as a value of `data_type`; returns (value, uses_node_id) where value excludes the $NODEID term."""
+    if data_type.is_text:
+        return text, False
+    if data_type.is_binary:
+        return _parse_hex_bytes(text), False
+    if data_type.is_float:
+        return _parse_float(data_type, text), False
+    node_id = _NODE_ID.match(text)
+    if node_id and "$" in text:
+        if not allow_node_id:
+            raise ValueSyntaxError(f"$NODEID is not allowed here ({text!r})")
+        constant = node_id["after"] or node_id["before"]
+        return (parse_integer(constant) if constant else 0), True
+    return parse_integer(text), False
+
+
+def _parse_float(data_type: DataType, text: str) -> float:
+    body = text.strip()
+    if body.lower().lstrip("+-").startswith("0x"):
+        pattern = parse_integer(body)
+        size = data_type.size
+        if not 0 <= pattern < 1 << (8 * size):
+            raise ValueSyntaxError(f"{text!r} is not a {size * 8}-bit IEEE-754 bit pattern")
+        fmt = "<f" if data_type is DataType.REAL32 else "<d"
+        return struct.unpack(fmt, pattern.to_bytes(size, "little"))[0]
+    try:
+        return float(body)
+    except ValueError:
+        raise ValueSyntaxError(f"{text!r} is not a number") from None
+
+
+def _parse_hex_bytes(text: str) -> bytes:
+    digits = "".join(text.split())
+    try:
+        return bytes.fromhex(digits)
+    except ValueError:
+        raise ValueSyntaxError(f"{text!r} is not a sequence of hexadecimal byte values") from None
+
+
+def float_bit_pattern(data_type: DataType, value: float) -> str:
+    """The EDS spelling of a REAL value that both our reader and dcf-tools understand."""
+    fmt = "<f" if data_type is DataType.REAL32 else "<d"
+    digits = data_type.size * 2
+    return f"0x{int.from_bytes(struct.pack(fmt, value), 'little'):0{digits}X}"
