@@ -14,7 +14,9 @@ from fastapi.responses import FileResponse, HTMLResponse
 from fastapi.staticfiles import StaticFiles
 
 from servostudio import __version__
-from servostudio.api.routes import dictionaries, health
+from servostudio.api.deps import install_communication
+from servostudio.api.routes import backup, buses, dictionaries, drives, events, health, projects
+from servostudio.api.routes.errors import register_error_handlers
 from servostudio.od import BUILTIN_EDS_DIR, EdsLibrary
 from servostudio.od.library import DEFAULT_USER_EDS_DIR
 
@@ -28,6 +30,7 @@ class Settings:
     projects_dir: Path = field(default_factory=lambda: Path("projects"))
     static_dir: Path = STATIC_DIR
     user_eds_dir: Path = DEFAULT_USER_EDS_DIR
+    buses: list[str] = field(default_factory=list)  # bus specs opened at startup
 
 
 def create_app(settings: Settings | None = None) -> FastAPI:
@@ -41,6 +44,11 @@ def create_app(settings: Settings | None = None) -> FastAPI:
     app.state.eds_library = EdsLibrary(BUILTIN_EDS_DIR, settings.user_eds_dir)
     app.include_router(health.router, prefix="/api")
     app.include_router(dictionaries.router, prefix="/api")
+    app.include_router(projects.router, prefix="/api")
+    install_communication(app, settings.buses)
+    register_error_handlers(app)
+    for router in (buses.router, drives.router, backup.router, events.router):
+        app.include_router(router, prefix="/api")
     _mount_ui(app, settings.static_dir)
     return app
 

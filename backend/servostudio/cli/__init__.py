@@ -10,8 +10,9 @@ import argparse
 import sys
 from pathlib import Path
 
-from servostudio.cli import eds
+from servostudio.cli import drive, eds, project
 from servostudio.cli.output import CommandError
+from servostudio.sim import cli as sim_cli
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -19,6 +20,9 @@ def build_parser() -> argparse.ArgumentParser:
     commands = parser.add_subparsers(dest="command", required=True)
     _add_serve(commands)
     eds.register(commands)
+    project.register(commands)
+    drive.register(commands)
+    sim_cli.register(commands)
     return parser
 
 
@@ -27,6 +31,8 @@ def _add_serve(commands: argparse._SubParsersAction) -> None:
     serve.add_argument("--host", default="127.0.0.1", help="address to bind (default: 127.0.0.1)")
     serve.add_argument("--port", type=int, default=8000, help="TCP port (default: 8000)")
     serve.add_argument("--projects", type=Path, default=Path("projects"), help="project store directory")
+    serve.add_argument("--bus", action="append", default=[], metavar="SPEC",
+                       help="bus to open at startup, repeatable (default: sim, the embedded simulated drives)")
     serve.set_defaults(handler=_serve)
 
 
@@ -35,7 +41,8 @@ def _serve(args: argparse.Namespace) -> int:
 
     from servostudio.api.app import Settings, create_app
 
-    app = create_app(Settings(projects_dir=args.projects))
+    drive.check_local_host(args.host)
+    app = create_app(Settings(projects_dir=args.projects, buses=args.bus or ["sim"]))
     uvicorn.run(app, host=args.host, port=args.port, log_level="info")
     return 0
 

@@ -1,0 +1,89 @@
+"""One drive: typed object read/write, CiA 402 state, faults."""
+
+from __future__ import annotations
+
+from fastapi import APIRouter, Depends, Query
+
+from servostudio.api.deps import current_user, get_connections
+from servostudio.api.routes.comm_models import (
+    DriveState,
+    FaultReportModel,
+    ObjectValueModel,
+    ObjectWrite,
+    ReadMany,
+    ReadResult,
+    StateRequest,
+)
+from servostudio.drive.access import Drive
+from servostudio.drive.cia402 import State
+from servostudio.drive.control import fault_report, read_state, reset_faults, set_state
+from servostudio.services.bus import ConnectionManager
+from servostudio.services.terminal import read_objects
+
+router = APIRouter(prefix="/buses/{bus}/nodes/{node}", tags=["drives"], dependencies=[Depends(current_user)])
+
+
+def _drive(bus: str, node: int, device: str | None, manager: ConnectionManager) -> Drive:
+    return manager.get(bus).drive(node, device)
+
+
+@router.get("/objects/{key}", response_model=ObjectValueModel,
+            summary="Read an object by address (0x6041, 0x60F9,2), name, or profile name (statusword)")
+def read_object(bus: str, node: int, key: str, device: str | None = Query(None, description="device key if the node "
+                "was not scanned"), manager: ConnectionManager = Depends(get_connections)) -> dict:
+    return _drive(bus, node, device, manager).read(key).as_dict()
+
+
+@router.put("/objects/{key}", response_model=ObjectValueModel,
+            summary="Write an object; access, type and range are checked before anything is sent")
+def write_object(bus: str, node: int, key: str, request: ObjectWrite, device: str | None = None,
+                 manager: ConnectionManager = Depends(get_connections)) -> dict:
+    return _drive(bus, node, device, manager).write(key, request.value, request.physical).as_dict()
+
+
+@router.post("/read", response_model=list[ReadResult], summary="Read several objects of this node at once")
+def read_many(bus: str, node: int, request: ReadMany, manager: ConnectionManager = Depends(get_connections),
+              ) -> list[dict]:
+    return read_objects(manager.get(bus).drive(node), request.objects)
+
+
+@router.get("/state", response_model=DriveState, summary="CiA 402 state and NMT state")
+def get_state(bus: str, node: int, manager: ConnectionManager = Depends(get_connections)) -> dict:
+    connection = manager.get(bus)
+    state, statusword = read_state(connection.drive(node))
+    _report(connection, node, statusword)
+    return {"node": node, "state": state.value if state else None, "statusword": statusword,
+            "nmt_state": connection.monitor.nmt_state(node) if connection.monitor else None}
+
+
+@router.put("/state", response_model=DriveState, summary="Walk the CiA 402 state machine to a target state")
+def put_state(bus: str, node: int, request: StateRequest, manager: ConnectionManager = Depends(get_connections),
+              ) -> dict:
+    connection = manager.get(bus)
+    drive = connection.drive(node)
+    set_state(drive, State.parse(request.target))
+    state, statusword = read_state(drive)
+    _report(connection, node, statusword)
+    return {"node": node, "state": state.value if state else None, "statusword": statusword,
+            "nmt_state": connection.monitor.nmt_state(node) if connection.monitor else None}
+
+
+@router.get("/faults", response_model=FaultReportModel, summary="Active faults and warnings with the manual's remedy")
+def get_faults(bus: str, node: int, manager: ConnectionManager = Depends(get_connections)) -> dict:
+    return fault_report(manager.get(bus).drive(node)).as_dict()
+
+
+@router.post("/faults/reset", response_model=FaultReportModel, summary="Fault reset (control word bit 7 edge)")
+def post_fault_reset(bus: str, node: int, manager: ConnectionManager = Depends(get_connections)) -> dict:
+    connection = manager.get(bus)
+    drive = connection.drive(node)
+    reset_faults(drive)
+    report = fault_report(drive)
+    _report(connection, node, report.statusword)
+    return report.as_dict()
+
+
+def _report(connection, node: int, statusword: int) -> None:
+    """Publish a drive_state event when the state read here differs from the last one known."""
+    if connection.monitor is not None:
+        connection.monitor.report_statusword(node, statusword)

@@ -1,0 +1,278 @@
+"""`servostudio project …`: the project store from the command line (same service as the REST API).
+
+Exit codes: 0 done; 3 refused (bad value, rule broken, conflicting change, unsafe archive; nothing written);
+4 not found (project, axis, object, motor, template).
+"""
+
+from __future__ import annotations
+
+import argparse
+import functools
+from pathlib import Path
+
+from servostudio.cli.output import EXIT_INVALID_INPUT, EXIT_NOT_FOUND, CommandError, emit
+from servostudio.od import BUILTIN_EDS_DIR, EdsLibrary
+from servostudio.od.library import DEFAULT_USER_EDS_DIR
+from servostudio.services.projects import Axis, Bus, ProjectError, ProjectNotFound, ProjectService
+from servostudio.services.projects.fsutil import atomic_write
+from servostudio.services.projects.jsonview import (
+    choice_view,
+    compare_view,
+    motor_view,
+    parameter_view,
+    project_view,
+    summaries,
+    template_view,
+)
+from servostudio.services.projects.motors import motor_from_text
+from servostudio.services.projects.templates import templates_for
+
+
+def register(commands: argparse._SubParsersAction) -> None:
+    project = commands.add_parser("project", help="projects, axes and offline parameters")
+    project.add_argument("--projects", type=Path, default=Path("projects"), help="project store directory")
+    project.add_argument("--user-eds-dir", type=Path, default=DEFAULT_USER_EDS_DIR, help="user EDS library")
+    actions = project.add_subparsers(dest="action", required=True)
+
+    def action(name: str, handler, summary: str) -> argparse.ArgumentParser:
+        parser = actions.add_parser(name, help=summary)
+        parser.set_defaults(handler=lambda args: _run(handler, args))
+        return parser
+
+    def revision(parser: argparse.ArgumentParser) -> None:
+        parser.add_argument("--revision", help="refuse the change if the project changed since this revision")
+
+    action("list", _list, "projects of the store")
+    create = action("create", _create, "create an empty project")
+    create.add_argument("name")
+    create.add_argument("--description", default="")
+    create.add_argument("--bus", action="append", default=[], metavar="NAME=INTERFACE[@BITRATE]",
+                        help="a bus, e.g. sim=sim or can0=socketcan:can0@500000 (repeatable)")
+    action("show", _show, "a project with its buses and axes").add_argument("name")
+    delete = action("delete", _delete, "delete a project")
+    delete.add_argument("name")
+    revision(delete)
+    for name, handler, text in (("rename", _rename, "rename a project"),
+                                ("duplicate", _duplicate, "copy a project under a new name")):
+        parser = action(name, handler, text)
+        parser.add_argument("name")
+        parser.add_argument("new_name")
+        revision(parser)
+
+    add = action("axis-add", _axis_add, "add an axis")
+    add.add_argument("name")
+    add.add_argument("axis")
+    add.add_argument("--device", required=True, help="device key, e.g. xtrapulspac")
+    add.add_argument("--node", type=int, required=True, help="node ID")
+    add.add_argument("--bus", required=True)
+    add.add_argument("--description", default="")
+    revision(add)
+    edit = action("axis-edit", _axis_edit, "change an axis (name, device, node ID, bus, description)")
+    edit.add_argument("name")
+    edit.add_argument("axis")
+    edit.add_argument("--new-name")
+    edit.add_argument("--device")
+    edit.add_argument("--node", type=int)
+    edit.add_argument("--bus")
+    edit.add_argument("--description")
+    revision(edit)
+    remove = action("axis-remove", _axis_remove, "remove an axis and its files")
+    remove.add_argument("name")
+    remove.add_argument("axis")
+    revision(remove)
+
+    setter = action("set", _set, "set parameters of an axis in the project (all or nothing)")
+    setter.add_argument("name")
+    setter.add_argument("axis")
+    setter.add_argument("assignments", nargs="+", metavar="ADDRESS=VALUE", help='e.g. 0x6060=-3 "60F9,2=1200"')
+    revision(setter)
+    getter = action("get", _get, "one parameter of an axis: project value, default, file")
+    getter.add_argument("name")
+    getter.add_argument("axis")
+    getter.add_argument("address")
+    reset = action("reset", _reset, "drop project values: the objects follow their defaults again")
+    reset.add_argument("name")
+    reset.add_argument("axis")
+    reset.add_argument("addresses", nargs="+")
+    revision(reset)
+    params = action("params", _params, "parameters of an axis")
+    params.add_argument("name")
+    params.add_argument("axis")
+    params.add_argument("--group")
+    params.add_argument("--only-set", action="store_true", help="only objects the project files set")
+    params.add_argument("--only-differences", action="store_true", help="only values that differ from default")
+    params.add_argument("--all", action="store_true", help="also objects not saved in a drive file")
+    compare = action("compare", _compare, "compare project values with the dictionary defaults")
+    compare.add_argument("name")
+    compare.add_argument("axis")
+    compare.add_argument("--group")
+    compare.add_argument("--only-differences", action="store_true")
+
+    archive = action("archive", _archive, "pack a project into one zip file")
+    archive.add_argument("name")
+    archive.add_argument("output", type=Path)
+    unarchive = action("unarchive", _unarchive, "unpack a project archive into the store")
+    unarchive.add_argument("archive", type=Path)
+    unarchive.add_argument("--name", help="store it under this name")
+    dcf = action("dcf", _dcf, "write the DCF (CiA 306) of an axis")
+    dcf.add_argument("name")
+    dcf.add_argument("axis")
+    dcf.add_argument("output", type=Path)
+
+    action("motor-list", _motor_list, "motors of the catalog")
+    motor_add = action("motor-add", _motor_add, "add a motor file to the user catalog")
+    motor_add.add_argument("file", type=Path)
+    action("motor-remove", _motor_remove, "remove a user motor from the catalog").add_argument("reference")
+    select = action("motor-select", _motor_select, "select a catalog motor for an axis")
+    select.add_argument("name")
+    select.add_argument("axis")
+    select.add_argument("reference")
+    revision(select)
+    templates = action("template-list", _template_list, "Device Config templates of a device")
+    templates.add_argument("--device", default="xtrapulspac")
+    apply = action("template-apply", _template_apply, "apply a Device Config template to an axis")
+    apply.add_argument("name")
+    apply.add_argument("axis")
+    apply.add_argument("template")
+    revision(apply)
+
+
+@functools.cache
+def _library(user_eds_dir: Path) -> EdsLibrary:
+    """One library per user directory, so a process running several commands parses each EDS once."""
+    return EdsLibrary(BUILTIN_EDS_DIR, user_eds_dir)
+
+
+def _run(handler, args: argparse.Namespace) -> int:
+    service = ProjectService(args.projects, _library(args.user_eds_dir))
+    try:
+        return emit(handler(service, args))
+    except ProjectNotFound as error:
+        raise CommandError(str(error), EXIT_NOT_FOUND) from None
+    except ProjectError as error:
+        raise CommandError(str(error), EXIT_INVALID_INPUT) from None
+
+
+def _list(service: ProjectService, args: argparse.Namespace) -> list[dict]:
+    return summaries(service.store)
+
+
+def _create(service: ProjectService, args: argparse.Namespace) -> dict:
+    return project_view(service.store.create(args.name, args.description, tuple(_bus(text) for text in args.bus)))
+
+
+def _bus(text: str) -> Bus:
+    name, equals, rest = text.partition("=")
+    interface, at, bitrate = rest.partition("@")
+    if not equals or not interface or (at and not bitrate.isdigit()):
+        raise CommandError(f"--bus {text!r}: expected NAME=INTERFACE or NAME=INTERFACE@BITRATE", EXIT_INVALID_INPUT)
+    return Bus(name, interface, int(bitrate) if at else None)
+
+
+def _show(service: ProjectService, args: argparse.Namespace) -> dict:
+    return project_view(service.store.open(args.name))
+
+
+def _delete(service: ProjectService, args: argparse.Namespace) -> dict:
+    service.store.delete(args.name, args.revision)
+    return {"deleted": args.name}
+
+
+def _rename(service: ProjectService, args: argparse.Namespace) -> dict:
+    return project_view(service.store.rename(args.name, args.new_name, args.revision))
+
+
+def _duplicate(service: ProjectService, args: argparse.Namespace) -> dict:
+    return project_view(service.store.duplicate(args.name, args.new_name))
+
+
+def _axis_add(service: ProjectService, args: argparse.Namespace) -> dict:
+    axis = Axis(args.axis, args.device, args.node, args.bus, args.description)
+    return project_view(service.store.add_axis(args.name, axis, args.revision))
+
+
+def _axis_edit(service: ProjectService, args: argparse.Namespace) -> dict:
+    changes = {key: value for key, value in (("name", args.new_name), ("device", args.device),
+                                             ("node_id", args.node), ("bus", args.bus),
+                                             ("description", args.description)) if value is not None}
+    return project_view(service.store.edit_axis(args.name, args.axis, args.revision, **changes))
+
+
+def _axis_remove(service: ProjectService, args: argparse.Namespace) -> dict:
+    return project_view(service.store.remove_axis(args.name, args.axis, args.revision))
+
+
+def _set(service: ProjectService, args: argparse.Namespace) -> dict:
+    changes = {}
+    for text in args.assignments:
+        address, equals, value = text.partition("=")
+        if not equals:
+            raise CommandError(f"{text!r}: expected ADDRESS=VALUE", EXIT_INVALID_INPUT)
+        changes[address] = value
+    change = service.parameters.set(args.name, args.axis, changes, args.revision)
+    return {"parameters": [parameter_view(row) for row in change.rows], "revision": change.revision}
+
+
+def _get(service: ProjectService, args: argparse.Namespace) -> dict:
+    row, _revision = service.parameters.get(args.name, args.axis, args.address)
+    return parameter_view(row)
+
+
+def _reset(service: ProjectService, args: argparse.Namespace) -> dict:
+    change = service.parameters.unset(args.name, args.axis, args.addresses, args.revision)
+    return {"parameters": [parameter_view(row) for row in change.rows], "revision": change.revision}
+
+
+def _params(service: ProjectService, args: argparse.Namespace) -> dict:
+    rows, revision = service.parameters.rows(args.name, args.axis, group=args.group, only_set=args.only_set,
+                                             only_differences=args.only_differences, include_unsaved=args.all)
+    return {"parameters": [parameter_view(row) for row in rows], "revision": revision}
+
+
+def _compare(service: ProjectService, args: argparse.Namespace) -> dict:
+    rows, revision = service.parameters.compare(args.name, args.axis, group=args.group,
+                                                only_differences=args.only_differences)
+    return {"columns": ["project", "default"], "rows": [compare_view(row) for row in rows], "revision": revision}
+
+
+def _archive(service: ProjectService, args: argparse.Namespace) -> dict:
+    return {"archive": str(service.archive(args.name, args.output))}
+
+
+def _unarchive(service: ProjectService, args: argparse.Namespace) -> dict:
+    return project_view(service.unarchive(args.archive, args.name))
+
+
+def _dcf(service: ProjectService, args: argparse.Namespace) -> dict:
+    text = service.dcf(args.name, args.axis)
+    atomic_write(args.output, text.encode("latin-1"))
+    return {"dcf": str(args.output)}
+
+
+def _motor_list(service: ProjectService, args: argparse.Namespace) -> list[dict]:
+    return [motor_view(motor) for motor in service.motors.motors()]
+
+
+def _motor_add(service: ProjectService, args: argparse.Namespace) -> dict:
+    try:
+        text = args.file.read_text(encoding="utf-8")
+    except OSError as error:
+        raise CommandError(f"{args.file}: {error.strerror}", EXIT_NOT_FOUND) from None
+    return motor_view(service.motors.add(motor_from_text(text, args.file)))
+
+
+def _motor_remove(service: ProjectService, args: argparse.Namespace) -> dict:
+    service.motors.remove(args.reference)
+    return {"removed": args.reference}
+
+
+def _motor_select(service: ProjectService, args: argparse.Namespace) -> dict:
+    return choice_view(service.select_motor(args.name, args.axis, args.reference, args.revision))
+
+
+def _template_list(service: ProjectService, args: argparse.Namespace) -> list[dict]:
+    return [template_view(template) for template in templates_for(args.device)]
+
+
+def _template_apply(service: ProjectService, args: argparse.Namespace) -> dict:
+    return choice_view(service.apply_template(args.name, args.axis, args.template, args.revision))

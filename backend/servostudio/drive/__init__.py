@@ -1,0 +1,1 @@
+"""drive layer (see servostudio/__init__.py)."""

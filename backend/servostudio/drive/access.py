@@ -1,0 +1,124 @@
+"""Drive access: read and write any object of one node through its object dictionary.
+
+Every check that can be made without the drive — does the object exist, may it be read or written, does the
+value fit its type, range and enumeration — is made before a frame is sent, and the error names the node and the
+object.  The drive's own refusals arrive as SDO aborts translated by ``servostudio.drive.sdo``.
+
+Methods block the calling thread (they wait on the SDO engine); the ``submit_*`` variants return futures so
+many reads can be queued at once (backup) and awaited from asyncio with ``asyncio.wrap_future``.
+"""
+
+from __future__ import annotations
+
+from concurrent.futures import Future
+
+from servostudio.drive.profiles import DeviceProfile, profile_for
+from servostudio.drive.sdo import SdoEngine
+from servostudio.drive.values import ObjectValue, Raw, ValueInputError, decode_raw, parse_input
+from servostudio.od.datatypes import DataType, encode
+from servostudio.od.model import Access, ObjectDictionary, Variable
+
+#: Safety net only: the engine completes every transfer (answer, abort, timeout or link loss), but a transfer
+#: may wait behind many queued ones of the same node.
+DEFAULT_WAIT = 120.0
+
+
+class DriveAccessError(ValueError):
+    """A read or write refused before anything was sent (unknown object, access, value)."""
+
+
+class Drive:
+    """One node on one bus, with its dictionary and device profile."""
+
+    def __init__(self, engine: SdoEngine, node: int, dictionary: ObjectDictionary | None,
+                 profile: DeviceProfile | None = None) -> None:
+        self.engine = engine
+        self.node = node
+        self.dictionary = dictionary
+        self.profile = profile or profile_for(dictionary.device if dictionary else None)
+
+    def __repr__(self) -> str:
+        return f"Drive(node={self.node}, device={self.profile.device!r})"
+
+    # -- object lookup -------------------------------------------------------------------------------------------
+    def variable(self, key: str | tuple[int, int]) -> Variable:
+        """An object by address ("0x6041", "0x60F9,2"), (index, sub) or name; a profile name ("statusword") too."""
+        if isinstance(key, str) and self.profile.has(key):
+            key = self.profile.address(key)
+        if self.dictionary is None:
+            raise DriveAccessError(f"node {self.node}: no object dictionary known for this drive")
+        try:
+            if isinstance(key, tuple):
+                return self.dictionary[key]
+            return self.dictionary.find(key)
+        except KeyError:
+            shown = f"0x{key[0]:04X},{key[1]}" if isinstance(key, tuple) else repr(key)
+            raise DriveAccessError(f"node {self.node}: object {shown} is not in the {self.dictionary.device} "
+                                   "dictionary") from None
+
+    # -- reads ---------------------------------------------------------------------------------------------------
+    def submit_read(self, variable: Variable, timeout: float | None = None) -> Future:
+        """Queue a read; the future gives an ObjectValue."""
+        if not variable.access.readable:
+            raise DriveAccessError(f"node {self.node}: {variable.label} is write-only")
+        result: Future = Future()
+        upload = self.engine.upload(self.node, variable.index, variable.subindex, timeout)
+        upload.add_done_callback(lambda done: _chain(done, result, lambda data: ObjectValue(
+            self.node, variable, decode_raw(variable, data))))
+        return result
+
+    def read(self, key: str | tuple[int, int] | Variable, timeout: float | None = None) -> ObjectValue:
+        variable = key if isinstance(key, Variable) else self.variable(key)
+        return self.submit_read(variable, timeout).result(DEFAULT_WAIT + (timeout or 0))
+
+    def read_raw(self, key: str | tuple[int, int]) -> Raw:
+        return self.read(key).raw
+
+    # -- writes --------------------------------------------------------------------------------------------------
+    def prepare_write(self, key: str | tuple[int, int] | Variable, value: object, physical: bool = False,
+                      ) -> tuple[Variable, Raw, bytes]:
+        """Check a write completely without sending anything; returns (variable, raw value, bytes to send)."""
+        variable = key if isinstance(key, Variable) else self.variable(key)
+        if not variable.access.writable:
+            kind = "constant" if variable.access is Access.CONST else "read-only"
+            raise DriveAccessError(f"node {self.node}: {variable.label} is {kind}")
+        try:
+            raw = parse_input(variable, value, physical)
+            data = encode(DataType(variable.data_type), raw)
+        except ValueError as error:
+            raise DriveAccessError(f"node {self.node}: {error}") from None
+        return variable, raw, data
+
+    def submit_write(self, key: str | tuple[int, int] | Variable, value: object, physical: bool = False,
+                     timeout: float | None = None) -> Future:
+        """Check, then queue a write; the future gives the ObjectValue written."""
+        variable, raw, data = self.prepare_write(key, value, physical)
+        result: Future = Future()
+        download = self.engine.download(self.node, variable.index, variable.subindex, data, timeout)
+        download.add_done_callback(lambda done: _chain(done, result, lambda _: ObjectValue(self.node, variable, raw)))
+        return result
+
+    def write(self, key: str | tuple[int, int] | Variable, value: object, physical: bool = False,
+              timeout: float | None = None) -> ObjectValue:
+        return self.submit_write(key, value, physical, timeout).result(DEFAULT_WAIT + (timeout or 0))
+
+    def write_raw_bytes(self, index: int, sub: int, data: bytes, timeout: float | None = None) -> None:
+        """Write bytes to an object the dictionary may not know (procedure signatures on unknown devices)."""
+        self.engine.download(self.node, index, sub, data, timeout).result(DEFAULT_WAIT + (timeout or 0))
+
+    def start_procedure(self, procedure: str, timeout: float = 10.0) -> None:
+        """Write a procedure's signature (decisions.md §4), e.g. "save" → 0x1010,1 = 'save'."""
+        (index, sub), value = self.profile.signature(procedure)
+        self.write_raw_bytes(index, sub, value.to_bytes(4, "little"), timeout)
+
+
+def _chain(done: Future, result: Future, convert) -> None:
+    """Complete ``result`` from ``done`` through ``convert`` (errors pass through)."""
+    error = done.exception()
+    if error is not None:
+        result.set_exception(error)
+        return
+    try:
+        result.set_result(convert(done.result()))
+    except (ValueError, ValueInputError) as conversion_error:
+        result.set_exception(conversion_error)

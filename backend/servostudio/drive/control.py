@@ -1,0 +1,99 @@
+"""Device control on a Drive: CiA 402 state changes, fault reading and fault reset."""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+
+from servostudio.drive.access import Drive
+from servostudio.drive.cia402 import Command, State, apply_command, decode_state, next_command
+from servostudio.drive.faults import FaultInfo, cia402_error_text, faults_from_words
+
+STEP_TIMEOUT = 1.0
+POLL_PERIOD = 0.01
+
+
+class StateChangeError(RuntimeError):
+    """The drive did not reach the requested state; names node, state reached and status word."""
+
+
+def read_state(drive: Drive) -> tuple[State | None, int]:
+    statusword = int(drive.read("statusword").raw)
+    return decode_state(statusword), statusword
+
+
+def set_state(drive: Drive, target: State, step_timeout: float = STEP_TIMEOUT) -> State:
+    """Walk the CiA 402 state machine to ``target`` one command at a time, checking each step."""
+    for _ in range(8):
+        state, statusword = read_state(drive)
+        if state is None:
+            raise StateChangeError(f"node {drive.node}: status word 0x{statusword:04X} is no CiA 402 state")
+        command = next_command(state, target)
+        if command is None:
+            return state
+        if command is Command.FAULT_RESET:
+            reset_faults(drive)
+        else:
+            controlword = int(drive.read("controlword").raw) if drive.variable("controlword").access.readable else 0
+            drive.write("controlword", apply_command(controlword, command))
+        _wait_for_change(drive, state, step_timeout)
+    state, statusword = read_state(drive)
+    raise StateChangeError(f"node {drive.node}: stuck in {state.value if state else '?'} "
+                           f"(status word 0x{statusword:04X}) on the way to {target.value}")
+
+
+def _wait_for_change(drive: Drive, previous: State, timeout: float) -> None:
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        state, statusword = read_state(drive)
+        if state is not previous and state is not State.FAULT_REACTION_ACTIVE:
+            return
+        time.sleep(POLL_PERIOD)
+    state, statusword = read_state(drive)
+    report = fault_report(drive) if state is State.FAULT else None
+    detail = f"; faults: {', '.join(f.name for f in report.faults)}" if report and report.faults else ""
+    raise StateChangeError(f"node {drive.node}: still {state.value if state else '?'} (status word "
+                           f"0x{statusword:04X}) {timeout:.1f} s after the command{detail}")
+
+
+def reset_faults(drive: Drive) -> None:
+    """Rising edge of control word bit 7, then bit 7 cleared again (the manual: the host must clear it)."""
+    controlword = int(drive.read("controlword").raw) & ~0x80
+    drive.write("controlword", controlword)
+    drive.write("controlword", apply_command(controlword, Command.FAULT_RESET) | (controlword & 0x0F00))
+    drive.write("controlword", controlword & ~0x8F)
+
+
+@dataclass
+class FaultReport:
+    node: int
+    state: str | None
+    statusword: int
+    error_code: int
+    error_text: str
+    faults: list[FaultInfo] = field(default_factory=list)
+    warnings: list[FaultInfo] = field(default_factory=list)
+
+    def as_dict(self) -> dict[str, object]:
+        return {"node": self.node, "state": self.state, "statusword": self.statusword, "fault": bool(self.statusword & 8),
+                "error_code": self.error_code, "error_text": self.error_text,
+                "faults": [item.as_dict() for item in self.faults],
+                "warnings": [item.as_dict() for item in self.warnings]}
+
+
+def fault_report(drive: Drive) -> FaultReport:
+    """Status word, 0x603F and the device's error/warning words decoded with the manual's texts."""
+    profile = drive.profile
+    state, statusword = read_state(drive)
+    error_code = int(drive.read("error_code").raw) if profile.has("error_code") else 0
+    error_text = cia402_error_text(error_code)
+    if error_code in profile.emcy_codes:
+        error_text = profile.emcy_codes[error_code].name
+    words = [(int(drive.read(name).raw), first) for name, first in profile.error_words]
+    faults = faults_from_words(dict(profile.errors), words)
+    if not faults and error_code in profile.emcy_codes:
+        faults = [profile.emcy_codes[error_code]]
+    warnings = []
+    if profile.warning_word:
+        warnings = faults_from_words(dict(profile.warnings), [(int(drive.read(profile.warning_word).raw), 1)])
+    return FaultReport(drive.node, state.value if state else None, statusword, error_code, error_text, faults, warnings)

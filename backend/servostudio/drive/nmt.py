@@ -1,0 +1,38 @@
+"""NMT commands (CiA 301): one frame on COB-ID 0, ``[command, node]``; node 0 addresses every node."""
+
+from __future__ import annotations
+
+import enum
+
+from servostudio.drive.link import BusLink
+
+
+class NmtCommand(enum.IntEnum):
+    START = 0x01
+    STOP = 0x02
+    PRE_OPERATIONAL = 0x80
+    RESET_NODE = 0x81
+    RESET_COMMUNICATION = 0x82
+
+    @classmethod
+    def parse(cls, text: str) -> NmtCommand:
+        """Accept the names the CLI and REST use: start, stop, pre-operational, reset-node, reset-communication."""
+        key = text.strip().lower().replace("-", "_").replace(" ", "_")
+        aliases = {"preop": "pre_operational", "reset": "reset_node", "reset_comm": "reset_communication",
+                   "operational": "start"}
+        key = aliases.get(key, key)
+        try:
+            return cls[key.upper()]
+        except KeyError:
+            names = ", ".join(name.lower().replace("_", "-") for name in cls.__members__)
+            raise ValueError(f"unknown NMT command {text!r}; use one of {names}") from None
+
+
+#: NMT state byte of heartbeat / boot-up frames (0x700 + node)
+NMT_STATES = {0x00: "INITIALISING", 0x04: "STOPPED", 0x05: "OPERATIONAL", 0x7F: "PRE-OPERATIONAL"}
+
+
+def send_nmt(link: BusLink, command: NmtCommand, node: int = 0) -> None:
+    if not 0 <= node <= 127:
+        raise ValueError(f"node ID {node} outside 0..127 (0 = all nodes)")
+    link.send(0x000, bytes([int(command), node]))

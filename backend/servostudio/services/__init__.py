@@ -1,0 +1,1 @@
+"""services layer (see servostudio/__init__.py)."""

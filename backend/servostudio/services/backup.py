@@ -1,0 +1,439 @@
+"""Backup and restore of drive parameters as the drive's own files (DRIVEPAR.TXT, USER_PAR.TXT, SEQUENCE.TXT).
+
+Backup reads every object of the file's save type (``SaveType`` in the dictionary) — all reads of a drive are
+queued at once, so the SDO engine keeps the drive busy back to back — and writes the object file atomically:
+if the link fails, no file (or the previous file) is left, never half a file.  Objects the drive refuses
+(abort) are left out and listed.
+
+Restore first validates the whole file against the dictionary (syntax, object known, writable, type and range);
+any error stops it with ``FILE:LINE: reason`` before anything is sent.  Then it writes every object, reads every
+one back (objects that another write changed as a side effect are written once more), stores to flash with the
+profile's signature, and reports per object.  A restore that fails part-way lists what was written; running it
+again is safe (it writes the same values).
+
+SEQUENCE.TXT goes through 0x3610 (select) / 0x3611 (26 parameters) with ``servostudio.formats.sequence``.
+"""
+
+from __future__ import annotations
+
+import enum
+import struct
+import time
+from collections.abc import Callable, Iterable
+from concurrent.futures import Future, ThreadPoolExecutor
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from servostudio.drive.access import Drive, DriveAccessError
+from servostudio.drive.cia402 import State, decode_state
+from servostudio.drive.sdo import SdoAbortError, SdoError
+from servostudio.drive.values import ObjectValue
+from servostudio.formats.objectfile import ObjectEntry, ObjectFileError, read_object_file, write_object_file
+from servostudio.formats.sequence import SequenceFileError, SequenceTable, read_sequence_file, write_sequence_file
+from servostudio.od.datatypes import DataType
+from servostudio.od.model import SaveType, Variable
+
+Progress = Callable[[dict[str, object]], None]
+SAVE_TIMEOUT = 10.0
+_PROGRESS_STEPS = 20
+
+
+class FileKind(str, enum.Enum):
+    DRIVEPAR = "DRIVEPAR.TXT"
+    USER_PAR = "USER_PAR.TXT"
+    SEQUENCE = "SEQUENCE.TXT"
+
+    @classmethod
+    def from_path(cls, path: Path) -> FileKind:
+        """The kind a file name says (case-insensitive, ``node3_DRIVEPAR.TXT`` too); DRIVEPAR otherwise."""
+        name = path.name.upper()
+        for kind in cls:
+            if name.endswith(kind.value) or name.endswith(kind.value.rsplit(".", 1)[0]):
+                return kind
+        return cls.DRIVEPAR
+
+    @property
+    def save_type(self) -> SaveType | None:
+        return {FileKind.DRIVEPAR: SaveType.DRIVEPAR, FileKind.USER_PAR: SaveType.USER_PAR}.get(self)
+
+
+class BackupError(RuntimeError):
+    """A backup or restore that could not complete; nothing half-written is left behind."""
+
+
+class RestoreValidationError(BackupError):
+    """The file is invalid; nothing was sent to the drive.  The message is ``FILE:LINE: reason``."""
+
+
+@dataclass
+class BackupResult:
+    node: int
+    file: str
+    kind: str
+    objects: int
+    skipped: list[dict[str, str]] = field(default_factory=list)
+    seconds: float = 0.0
+
+    def as_dict(self) -> dict[str, object]:
+        return {"node": self.node, "file": self.file, "kind": self.kind, "objects": self.objects,
+                "skipped": self.skipped, "seconds": round(self.seconds, 3)}
+
+
+@dataclass
+class ObjectOutcome:
+    label: str
+    value: int | str
+    status: str  # verified | failed | not written
+    error: str = ""
+
+
+@dataclass
+class RestoreResult:
+    node: int
+    file: str
+    kind: str
+    outcomes: list[ObjectOutcome] = field(default_factory=list)
+    stored: str = ""
+    error: str = ""
+    seconds: float = 0.0
+
+    @property
+    def ok(self) -> bool:
+        return not self.error and all(outcome.status == "verified" for outcome in self.outcomes)
+
+    def as_dict(self) -> dict[str, object]:
+        counts: dict[str, int] = {}
+        for outcome in self.outcomes:
+            counts[outcome.status] = counts.get(outcome.status, 0) + 1
+        return {"node": self.node, "file": self.file, "kind": self.kind, "ok": self.ok, "counts": counts,
+                "stored": self.stored, "error": self.error or None, "seconds": round(self.seconds, 3),
+                "objects": [outcome.__dict__ for outcome in self.outcomes if outcome.status != "verified"]}
+
+
+# ---------------------------------------------------------------------------------------------------- backup --
+def backup_objects(drive: Drive, save_type: SaveType) -> list[Variable]:
+    """Objects of a save type that a restore can write back (readable and writable)."""
+    if drive.dictionary is None:
+        raise BackupError(f"node {drive.node}: no object dictionary known for this drive; scan the bus first")
+    return [var for var in drive.dictionary.variables()
+            if var.save_type is save_type and var.access.readable and var.access.writable
+            and var.data_type not in (DataType.DOMAIN, DataType.OCTET_STRING)]
+
+
+def backup_file(drive: Drive, path: Path, kind: FileKind | None = None, progress: Progress | None = None) -> BackupResult:
+    """Back up one file of one drive; the file is written atomically at the end."""
+    kind = kind or FileKind.from_path(path)
+    started = time.monotonic()
+    if kind is FileKind.SEQUENCE:
+        table = _read_sequences(drive, progress)
+        write_sequence_file(path, table, header=_header(drive, kind))
+        return BackupResult(drive.node, str(path), kind.value, len(table), seconds=time.monotonic() - started)
+    variables = backup_objects(drive, kind.save_type)
+    values, skipped = _read_all(drive, variables, kind, progress)
+    entries = []
+    for value in values:
+        file_value = _file_value(value)
+        if isinstance(file_value, str) and _unwritable_text(file_value):
+            skipped.append({"object": value.variable.label, "reason": f"text {file_value!r} has no object-file syntax "
+                            "(empty, padded, numeric-looking or with ';')"})
+            continue
+        entries.append(ObjectEntry(value.variable.index, value.variable.subindex, file_value))
+    write_object_file(path, entries, header=_header(drive, kind))
+    return BackupResult(drive.node, str(path), kind.value, len(entries), skipped, time.monotonic() - started)
+
+
+def _read_all(drive: Drive, variables: list[Variable], kind: FileKind, progress: Progress | None,
+              ) -> tuple[list[ObjectValue], list[dict[str, str]]]:
+    futures = [(var, drive.submit_read(var)) for var in variables]  # all queued: the engine pipelines them
+    reporter = _Reporter(progress, "backup", drive.node, kind.value, len(futures))
+    values, skipped = [], []
+    for var, future in futures:
+        try:
+            values.append(future.result())
+        except SdoAbortError as error:
+            skipped.append({"object": var.label, "reason": error.reason})
+        except SdoError as error:
+            _cancel(future for _, future in futures)
+            raise BackupError(f"backup of node {drive.node} ({kind.value}) stopped, no file written: {error}") from None
+        reporter.step()
+    return values, skipped
+
+
+def _file_value(value: ObjectValue) -> int | str:
+    """Object-file spelling: integers as they are, REAL32/64 as their IEEE-754 bit pattern, text as text."""
+    raw = value.raw
+    if isinstance(raw, float):
+        fmt = "<f" if value.variable.data_type is DataType.REAL32 else "<d"
+        return int.from_bytes(struct.pack(fmt, raw), "little")
+    if isinstance(raw, str):
+        return raw.rstrip("\0")
+    return raw
+
+
+def _unwritable_text(text: str) -> bool:
+    """The object file cannot spell empty or padded text, text that starts like a number, or ';' and line breaks."""
+    return (not text or text != text.strip() or text[0] in "+-0123456789"
+            or any(char in text for char in ";\r\n"))
+
+
+def _header(drive: Drive, kind: FileKind) -> str:
+    device = drive.dictionary.product_name if drive.dictionary else drive.profile.device
+    return f"{kind.value} of node {drive.node} ({device}), Servo Studio backup {time.strftime('%Y-%m-%d %H:%M:%S')}"
+
+
+def backup_drive(drive: Drive, directory: Path, kinds: Iterable[FileKind] | None = None,
+                 progress: Progress | None = None) -> list[BackupResult]:
+    """All backup files of a drive into ``directory`` (the profile's parameter files, plus SEQUENCE.TXT)."""
+    directory.mkdir(parents=True, exist_ok=True)
+    return [backup_file(drive, directory / kind.value, kind, progress) for kind in (kinds or drive_file_kinds(drive))]
+
+
+def drive_file_kinds(drive: Drive) -> list[FileKind]:
+    kinds = [FileKind(name) for name in drive.profile.parameter_files]
+    if drive.profile.has_sequences and drive.profile.has("sequence_parameters"):
+        kinds.append(FileKind.SEQUENCE)
+    return kinds
+
+
+def run_per_drive(drives: list[Drive], work: Callable[[Drive], object]) -> dict[int, object]:
+    """Run ``work`` on every drive in parallel; the result per node is its value or the exception it raised."""
+    results: dict[int, object] = {}
+    with ThreadPoolExecutor(max_workers=max(1, len(drives)), thread_name_prefix="per-drive") as pool:
+        futures = {drive.node: pool.submit(work, drive) for drive in drives}
+        for node, future in futures.items():
+            try:
+                results[node] = future.result()
+            except Exception as error:  # reported per drive, the others go on
+                results[node] = error
+    return results
+
+
+# --------------------------------------------------------------------------------------------------- restore --
+def validate_object_file(drive: Drive, path: Path) -> list[tuple[ObjectEntry, Variable, bytes]]:
+    """Parse and check the whole file; raise RestoreValidationError (file, line, reason) on the first problem."""
+    checked: list[tuple[ObjectEntry, Variable, bytes]] = []
+
+    def validate(entry: ObjectEntry) -> str | None:
+        try:
+            variable = drive.variable((entry.index, entry.sub))
+            value = _entry_value(variable, entry.value)
+            variable, _, data = drive.prepare_write(variable, value)
+        except (DriveAccessError, ValueError) as error:
+            return str(error).removeprefix(f"node {drive.node}: ")
+        checked.append((entry, variable, data))
+        return None
+
+    try:
+        read_object_file(path, validate)
+    except ObjectFileError as error:
+        raise RestoreValidationError(f"{error} — nothing was written to node {drive.node}") from None
+    except OSError as error:
+        raise RestoreValidationError(f"{path}: {error.strerror}") from None
+    return checked
+
+
+def _entry_value(variable: Variable, value: int | str) -> int | float | str:
+    if variable.data_type.is_float and isinstance(value, int):
+        fmt, size = ("<f", 4) if variable.data_type is DataType.REAL32 else ("<d", 8)
+        if not 0 <= value < 1 << (8 * size):
+            raise ValueError(f"{variable.label}: {value} is not a {variable.data_type.name} bit pattern")
+        return struct.unpack(fmt, value.to_bytes(size, "little"))[0]
+    if variable.data_type.is_text and isinstance(value, int):
+        return str(value)
+    return value
+
+
+def restore_file(drive: Drive, path: Path, kind: FileKind | None = None, progress: Progress | None = None,
+                 store: bool = True) -> RestoreResult:
+    """Validate, write, verify and store one file to one drive."""
+    kind = kind or FileKind.from_path(path)
+    started = time.monotonic()
+    result = RestoreResult(drive.node, str(path), kind.value)
+    if kind is FileKind.SEQUENCE:
+        table, writes = _validated_sequence_writes(drive, path)
+    else:
+        writes = [(var, _entry_value(var, entry.value)) for entry, var, _ in validate_object_file(drive, path)]
+    _check_can_store(drive, store)
+    try:
+        if kind is FileKind.SEQUENCE:
+            result.outcomes = _write_sequences(drive, table, writes, progress)
+        else:
+            result.outcomes = _write_and_verify(drive, writes, kind, progress)
+        if store and all(outcome.status == "verified" for outcome in result.outcomes):
+            procedure = "save_sequences" if kind is FileKind.SEQUENCE else "save"
+            drive.start_procedure(procedure, timeout=SAVE_TIMEOUT)
+            result.stored = procedure
+    except (SdoError, BackupError) as error:
+        result.error = str(error)
+    result.seconds = time.monotonic() - started
+    return result
+
+
+def _check_can_store(drive: Drive, store: bool) -> None:
+    if store and drive.profile.save_needs_disabled:
+        state = decode_state(int(drive.read("statusword").raw))
+        if state is State.OPERATION_ENABLED:
+            raise BackupError(f"node {drive.node}: {drive.profile.device} stores parameters only with the drive "
+                              "disabled; disable it first — nothing was written")
+
+
+def _write_and_verify(drive: Drive, writes: list[tuple[Variable, object]], kind: FileKind,
+                      progress: Progress | None) -> list[ObjectOutcome]:
+    """Write all, read all back; rewrite what a later write changed (side effects), read back once more."""
+    outcomes = {index: ObjectOutcome(var.label, _shown(value), "not written") for index, (var, value) in enumerate(writes)}
+    reporter = _Reporter(progress, "restore", drive.node, kind.value, 2 * len(writes))
+    pending = list(range(len(writes)))
+    for attempt in range(2):
+        write_futures = [(index, drive.submit_write(writes[index][0], writes[index][1])) for index in pending]
+        link_error: SdoError | None = None
+        for index, future in write_futures:
+            try:
+                future.result()
+                outcomes[index].status, outcomes[index].error = "written", ""
+            except SdoAbortError as error:
+                outcomes[index].status, outcomes[index].error = "failed", error.reason
+            except SdoError as error:
+                link_error = link_error or error
+            reporter.step()
+        if link_error is not None:
+            raise_with = _partial(drive, outcomes, link_error)
+            raise raise_with
+        readable = [index for index in pending if outcomes[index].status == "written"
+                    and writes[index][0].access.readable]
+        read_futures = [(index, drive.submit_read(writes[index][0])) for index in readable]
+        mismatched = []
+        for index, future in read_futures:
+            try:
+                value = future.result().raw
+            except SdoError as error:
+                if not isinstance(error, SdoAbortError):
+                    raise _partial(drive, outcomes, error) from None
+                outcomes[index].status, outcomes[index].error = "failed", f"read back: {error.reason}"
+                continue
+            if _same(value, writes[index][1]):
+                outcomes[index].status = "verified"
+            else:
+                outcomes[index].status, outcomes[index].error = "failed", f"read back {_shown(value)}"
+                mismatched.append(index)
+            reporter.step()
+        for index in pending:
+            if outcomes[index].status == "written":  # write-only objects cannot be read back
+                outcomes[index].status = "verified"
+        pending = mismatched
+        if not pending:
+            break
+    return [outcomes[index] for index in range(len(writes))]
+
+
+def _partial(drive: Drive, outcomes: dict[int, ObjectOutcome], error: SdoError) -> BackupError:
+    written = [outcome.label for outcome in outcomes.values() if outcome.status in ("written", "verified")]
+    return BackupError(f"restore of node {drive.node} stopped: {error}. {len(written)} of {len(outcomes)} objects "
+                       "had been written; nothing was stored to flash. Run the restore again once the link is back.")
+
+
+def _same(read: object, written: object) -> bool:
+    if isinstance(read, float) or isinstance(written, float):
+        return abs(float(read) - float(written)) <= 1e-6 * max(1.0, abs(float(written)))
+    if isinstance(read, str) and isinstance(written, str):
+        return read.rstrip("\0") == written
+    return read == written
+
+
+def _shown(value: object) -> int | str:
+    return value if isinstance(value, (int, str)) else str(value)
+
+
+# ------------------------------------------------------------------------------------------------- sequences --
+def _read_sequences(drive: Drive, progress: Progress | None) -> SequenceTable:
+    count = int(drive.read("max_sequences").raw)
+    number_var, type_var = drive.variable("sequence_number"), drive.variable((0x3611, 1))
+    reporter = _Reporter(progress, "backup", drive.node, FileKind.SEQUENCE.value, count)
+    types: dict[int, Future] = {}
+    for number in range(count):  # per-node FIFO: each read sees the number selected just before it
+        drive.submit_write(number_var, number)
+        types[number] = drive.submit_read(type_var)
+    records: dict[int, dict[int, Future]] = {}
+    try:
+        used = [number for number, future in types.items() if future.result().raw != 0]
+        subs = sorted(sub for sub in drive.dictionary.object(0x3611).subs if sub >= 1)
+        for number in used:
+            drive.submit_write(number_var, number)
+            records[number] = {sub: drive.submit_read(drive.variable((0x3611, sub))) for sub in subs}
+        values = {number: {sub: int(future.result().raw) for sub, future in record.items()}
+                  for number, record in records.items()}
+    except SdoError as error:
+        raise BackupError(f"backup of node {drive.node} (SEQUENCE.TXT) stopped, no file written: {error}") from None
+    reporter.finish()
+    try:
+        return SequenceTable.from_object_values(values)
+    except ValueError as error:
+        raise BackupError(f"node {drive.node}: {error}") from None
+
+
+def _validated_sequence_writes(drive: Drive, path: Path) -> tuple[SequenceTable, list[tuple[Variable, object]]]:
+    count = int(drive.read("max_sequences").raw)
+    try:
+        table = read_sequence_file(path, max_sequences=count)
+    except SequenceFileError as error:
+        raise RestoreValidationError(f"{error} — nothing was written to node {drive.node}") from None
+    except OSError as error:
+        raise RestoreValidationError(f"{path}: {error.strerror}") from None
+    writes = []
+    for write in table.to_object_writes(clear_below=count):
+        try:
+            variable, raw, _ = drive.prepare_write((write.index, write.sub), write.value)
+        except DriveAccessError as error:
+            raise RestoreValidationError(f"{path}: {error} — nothing was written") from None
+        writes.append((variable, raw))
+    return table, writes
+
+
+def _write_sequences(drive: Drive, table: SequenceTable, writes: list[tuple[Variable, object]],
+                     progress: Progress | None) -> list[ObjectOutcome]:
+    """Write the whole sequence memory (LOAD semantics), then read it back and compare sequence by sequence."""
+    futures = [drive.submit_write(variable, value) for variable, value in writes]
+    reporter = _Reporter(progress, "restore", drive.node, FileKind.SEQUENCE.value, len(futures))
+    for future in futures:
+        try:
+            future.result()
+        except SdoAbortError as error:
+            raise BackupError(f"node {drive.node}: sequence memory refused a write: {error}") from None
+        reporter.step()
+    memory = _read_sequences(drive, None)
+    outcomes = []
+    for number in sorted(set(table) | set(memory)):
+        wanted, found = table.sequences.get(number), memory.sequences.get(number)
+        status = "verified" if wanted == found else "failed"
+        outcomes.append(ObjectOutcome(f"sequence {number}", wanted.type.name if wanted else "empty", status,
+                                      "" if status == "verified" else f"drive holds {found.type.name if found else 'empty'}"))
+    return outcomes
+
+
+# ------------------------------------------------------------------------------------------------- helpers --
+class _Reporter:
+    """Progress events, about every 5 % (a WebSocket client does not need one per object)."""
+
+    def __init__(self, progress: Progress | None, operation: str, node: int, file: str, total: int) -> None:
+        self.progress, self.operation, self.node, self.file, self.total = progress, operation, node, file, total
+        self.done = 0
+        self.every = max(1, total // _PROGRESS_STEPS)
+        self._emit()
+
+    def step(self) -> None:
+        self.done += 1
+        if self.done % self.every == 0 or self.done == self.total:
+            self._emit()
+
+    def finish(self) -> None:
+        self.done = self.total
+        self._emit()
+
+    def _emit(self) -> None:
+        if self.progress is not None:
+            self.progress({"type": "progress", "operation": self.operation, "node": self.node, "file": self.file,
+                           "done": self.done, "total": self.total})
+
+
+def _cancel(futures: Iterable[Future]) -> None:
+    for future in futures:
+        future.cancel()

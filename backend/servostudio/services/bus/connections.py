@@ -1,0 +1,154 @@
+"""The communication server's buses: several open at once, each with its SDO engine, monitor and known drives.
+
+A bus is opened from a spec string (``servostudio.transport.spec``).  ``sim`` builds simulated drives in this
+process.  A bus whose interface is missing or lost stays registered and reconnects by itself; its state changes
+are published as ``bus_state`` events.
+"""
+
+from __future__ import annotations
+
+import itertools
+import threading
+from collections.abc import Callable
+from dataclasses import asdict, dataclass, field
+
+import can
+
+from servostudio.drive.access import Drive
+from servostudio.drive.link import BusLink
+from servostudio.drive.monitor import BusMonitor
+from servostudio.drive.profiles import DeviceProfile, profile_for
+from servostudio.drive.sdo import SdoEngine
+from servostudio.od.library import EdsLibrary, builtin_library
+from servostudio.services.bus.events import EventHub
+from servostudio.transport.open import open_bus
+from servostudio.transport.spec import BusSpec, parse_bus_spec
+
+SERIAL_SDO_TIMEOUT = 1.0  # at 19200 baud a request and its answer alone take 12.5 ms, a forwarded one more
+CAN_SDO_TIMEOUT = 0.5
+
+
+class UnknownBusOrNode(LookupError):
+    """Unknown bus or node."""
+
+
+@dataclass
+class NodeInfo:
+    """What a scan learned about a node."""
+
+    node: int
+    device: str | None = None
+    device_type: int | None = None
+    vendor_id: int | None = None
+    product_code: int | None = None
+    revision: int | None = None
+    serial_number: int | None = None
+    device_name: str | None = None
+    hardware_version: str | None = None
+    software_version: str | None = None
+
+    def as_dict(self) -> dict[str, object]:
+        return asdict(self)
+
+
+@dataclass
+class BusConnection:
+    """One open bus."""
+
+    id: str
+    spec: BusSpec
+    link: BusLink
+    engine: SdoEngine
+    library: EdsLibrary
+    events: EventHub
+    nodes: dict[int, NodeInfo] = field(default_factory=dict)
+    simulation: object | None = None
+    monitor: BusMonitor | None = None
+
+    def drive(self, node: int, device: str | None = None) -> Drive:
+        """Drive access for a node: the device found by the scan, else ``device``, else the only known device."""
+        if not 1 <= node <= 127:
+            raise UnknownBusOrNode(f"node ID {node} outside 1..127")
+        info = self.nodes.get(node)
+        device = device or (info.device if info else None)
+        dictionary = self.library.load(device) if device else None
+        return Drive(self.engine, node, dictionary, profile_for(device))
+
+    def profile_of(self, node: int) -> DeviceProfile | None:
+        info = self.nodes.get(node)
+        return profile_for(info.device) if info and info.device else None
+
+    def status(self) -> dict[str, object]:
+        return {"id": self.id, "spec": str(self.spec), "kind": self.spec.kind, "connected": self.link.connected,
+                "error": self.link.last_error or None,
+                "nodes": [info.as_dict() for info in sorted(self.nodes.values(), key=lambda item: item.node)]}
+
+    def close(self) -> None:
+        self.link.close()
+        if self.simulation is not None:
+            self.simulation.stop()
+
+
+class ConnectionManager:
+    """All buses of the server (or of one CLI command)."""
+
+    def __init__(self, library: EdsLibrary | None = None, events: EventHub | None = None) -> None:
+        self.library = library or builtin_library()
+        self.events = events or EventHub()
+        self._buses: dict[str, BusConnection] = {}
+        self._lock = threading.Lock()
+        self._numbers = itertools.count()
+
+    def open(self, spec_text: str, bus_id: str | None = None, wait: float = 2.0) -> BusConnection:
+        """Open (or re-use) the bus a spec names; waits up to ``wait`` s for the first connection."""
+        spec = parse_bus_spec(spec_text)
+        with self._lock:
+            for existing in self._buses.values():
+                if existing.spec == spec:
+                    return existing
+            bus_id = bus_id or f"bus{next(self._numbers)}"
+            if bus_id in self._buses:
+                raise ValueError(f"a bus named {bus_id!r} is already open")
+        opener, simulation = self._opener(spec)
+        link = BusLink(bus_id, opener)
+        timeout = SERIAL_SDO_TIMEOUT if spec.kind == "serial" else CAN_SDO_TIMEOUT
+        connection = BusConnection(bus_id, spec, link, SdoEngine(link, timeout), self.library, self.events,
+                                   simulation=simulation)
+        connection.monitor = BusMonitor(link, self.events.publish, connection.profile_of)
+        link.on_state(lambda connected, reason: self.events.publish(
+            {"type": "bus_state", "bus": bus_id, "connected": connected, "reason": reason}))
+        with self._lock:
+            self._buses[bus_id] = connection
+        link.start(wait)
+        return connection
+
+    def _opener(self, spec: BusSpec) -> tuple[Callable[[], can.BusABC], object | None]:
+        if spec.kind != "sim":
+            return (lambda: open_bus(spec)), None
+        from servostudio.sim.network import SimulatedNetwork
+
+        network = SimulatedNetwork(spec.channel)
+        network.start()
+        return (lambda: network.open_bus()), network
+
+    def get(self, bus_id: str) -> BusConnection:
+        try:
+            return self._buses[bus_id]
+        except KeyError:
+            known = ", ".join(self._buses) or "none"
+            raise UnknownBusOrNode(f"no bus {bus_id!r} (open buses: {known})") from None
+
+    def list(self) -> list[BusConnection]:
+        return list(self._buses.values())
+
+    def close(self, bus_id: str) -> None:
+        with self._lock:
+            connection = self._buses.pop(bus_id, None)
+        if connection is None:
+            raise UnknownBusOrNode(f"no bus {bus_id!r}")
+        connection.close()
+        self.events.publish({"type": "bus_closed", "bus": bus_id})
+
+    def close_all(self) -> None:
+        for bus_id in list(self._buses):
+            self.close(bus_id)

@@ -1,0 +1,71 @@
+"""Background jobs (backup, restore of many drives): run in a thread, publish progress and the result as events.
+
+A REST call that would take seconds starts a job and returns its id at once; the client follows it on
+``/api/ws/events`` (``progress`` and ``job`` events) or polls ``GET /api/jobs/{id}``.
+"""
+
+from __future__ import annotations
+
+import itertools
+import threading
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+from servostudio.services.bus.events import EventHub
+
+Progress = Callable[[dict[str, object]], None]
+KEEP_JOBS = 100
+
+
+@dataclass
+class Job:
+    id: str
+    operation: str
+    state: str = "running"  # running | done | failed
+    result: object = None
+    error: str = ""
+    started: float = field(default_factory=time.time)
+    finished: float | None = None
+
+    def as_dict(self) -> dict[str, object]:
+        return {"id": self.id, "operation": self.operation, "state": self.state, "result": self.result,
+                "error": self.error or None, "started": self.started, "finished": self.finished}
+
+
+class JobRegistry:
+    def __init__(self, events: EventHub) -> None:
+        self.events = events
+        self._jobs: dict[str, Job] = {}
+        self._numbers = itertools.count(1)
+        self._lock = threading.Lock()
+
+    def start(self, operation: str, work: Callable[[Progress], object]) -> Job:
+        """Run ``work(progress)`` in a thread; its return value (JSON-ready) becomes the job's result."""
+        job = Job(id=f"job{next(self._numbers)}", operation=operation)
+        with self._lock:
+            self._jobs[job.id] = job
+            for old in list(self._jobs)[:-KEEP_JOBS]:
+                del self._jobs[old]
+
+        def progress(event: dict[str, object]) -> None:
+            self.events.publish({**event, "job": job.id})
+
+        def run() -> None:
+            try:
+                job.result = work(progress)
+                job.state = "done"
+            except Exception as error:  # the job reports any failure to its client
+                job.error = str(error)
+                job.state = "failed"
+            job.finished = time.time()
+            self.events.publish({"type": "job", **job.as_dict()})
+
+        threading.Thread(target=run, name=job.id, daemon=True).start()
+        return job
+
+    def get(self, job_id: str) -> Job | None:
+        return self._jobs.get(job_id)
+
+    def list(self) -> list[Job]:
+        return list(self._jobs.values())

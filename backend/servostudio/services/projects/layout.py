@@ -1,0 +1,6 @@
+"""Names of the files and directories of the project store (documented in docs/projects.md)."""
+
+PROJECT_FILE = "project.toml"
+SEQUENCE = "SEQUENCE.TXT"
+USER_MOTORS_DIR = ".motors"          # user motor catalog inside the project store (names never start with '.')
+TEMP_PREFIX = "."                    # temporary files and directories start with a dot and are never listed

@@ -1,0 +1,96 @@
+"""One entry point for the API and the CLI: the store plus everything done to a project's axes."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+from pathlib import Path
+
+from servostudio.formats.sequence import SequenceFileError, parse_sequence_text
+from servostudio.formats.textfile import FILE_ENCODING
+from servostudio.services.projects import layout
+from servostudio.services.projects.archive import DEFAULT_LIMITS, ArchiveLimits, archive_project, unarchive_project
+from servostudio.services.projects.axisvalues import AxisValues
+from servostudio.services.projects.dcf import export_dcf
+from servostudio.services.projects.errors import FileFormatError
+from servostudio.services.projects.model import Project
+from servostudio.services.projects.motors import BUILTIN_MOTORS_DIR, MotorCatalog
+from servostudio.services.projects.motorselect import apply_motor
+from servostudio.services.projects.parameters import DictionaryLibrary, ParameterChange, ParameterService, parameter_row
+from servostudio.services.projects.store import ProjectStore, Snapshot
+from servostudio.services.projects.templates import ApplicationTemplate, template
+
+
+@dataclass(frozen=True)
+class AxisChoice:
+    """Result of selecting a motor or a template: the objects set, what could not be reproduced, the new state."""
+
+    change: ParameterChange
+    notes: list[str]
+    snapshot: Snapshot
+
+
+class ProjectService:
+    def __init__(self, root: Path, library: DictionaryLibrary, motors_dir: Path = BUILTIN_MOTORS_DIR) -> None:
+        self.store = ProjectStore(root, library)
+        self.library = library
+        self.parameters = ParameterService(self.store, library)
+        self.motors = MotorCatalog(motors_dir, Path(root) / layout.USER_MOTORS_DIR)
+
+    def select_motor(self, project: str, axis: str, reference: str,
+                     expected_revision: str | None = None) -> AxisChoice:
+        """Record the catalog motor for the axis and set its values and their consequences (all or nothing)."""
+        motor = self.motors.get(reference)
+        with self.store.edit(project, expected_revision) as edit:
+            values = self.parameters.axis_values(edit, axis)
+            applied = apply_motor(values, motor)
+            values.commit(edit, axis)
+            self.store.replace_axis(edit, replace(edit.axis(axis), motor=motor.reference))
+        rows = [parameter_row(values, variable) for variable in applied.changed]
+        return AxisChoice(ParameterChange(rows, edit.revision), applied.notes, Snapshot(edit.project, edit.revision))
+
+    def apply_template(self, project: str, axis: str, key: str, expected_revision: str | None = None) -> AxisChoice:
+        """Set the template's mode and I/O functions and record it as the axis's application (all or nothing)."""
+        with self.store.edit(project, expected_revision) as edit:
+            chosen = template(key, edit.axis(axis).device)
+            values = self.parameters.axis_values(edit, axis)
+            touched = []
+            for setting in chosen.settings:
+                variable = values.resolve(f"0x{setting.index:04X},{setting.sub}")
+                values.stage(variable, setting.value)
+                touched.append(variable)
+            values.commit(edit, axis)
+            self.store.replace_axis(edit, replace(edit.axis(axis), application=chosen.key))
+        rows = [parameter_row(values, variable) for variable in touched]
+        return AxisChoice(ParameterChange(rows, edit.revision), [], Snapshot(edit.project, edit.revision))
+
+    def application(self, project: str, axis: str) -> ApplicationTemplate | None:
+        chosen = self.store.open(project).project.axis(axis)
+        return template(chosen.application, chosen.device) if chosen and chosen.application else None
+
+    def dcf(self, project: str, axis: str) -> str:
+        with self.store.read(project) as view:
+            chosen = view.axis(axis)
+            values = self.parameters.axis_values(view, axis)
+            eds_text = values.dictionary.source.read_text(encoding="latin-1")
+            return export_dcf(eds_text, view.project, chosen, values)
+
+    def archive(self, project: str, destination: Path) -> Path:
+        return archive_project(self.store, project, destination)
+
+    def unarchive(self, source: Path, new_name: str | None = None,
+                  limits: ArchiveLimits = DEFAULT_LIMITS) -> Snapshot:
+        return unarchive_project(self.store, source, new_name, limits, verify=self.check_axis_files)
+
+    def check_axis_files(self, directory: Path, project: Project) -> None:
+        """Parse every axis's object files against its dictionary and its SEQUENCE.TXT; raise
+        :class:`FileFormatError` naming the first bad file and line."""
+        for axis in project.axes:
+            axis_directory = directory / axis.name
+            AxisValues.load(axis_directory, self.parameters.dictionary(axis), axis.node_id)
+            sequence = axis_directory / layout.SEQUENCE
+            if sequence.is_file():
+                try:
+                    parse_sequence_text(sequence.read_text(encoding=FILE_ENCODING), str(sequence))
+                except SequenceFileError as error:
+                    first = error.issues[0]
+                    raise FileFormatError(sequence, first.line, str(first).partition(": ")[2]) from None

@@ -1,0 +1,331 @@
+"""The project store: one directory per project under a root directory.
+
+Layout (docs/projects.md)::
+
+    <root>/<project>/project.toml
+    <root>/<project>/<axis>/DRIVEPAR.TXT, USER_PAR.TXT, SEQUENCE.TXT
+
+Concurrency: operations on one project hold an exclusive ``flock`` on the project directory; operations that create,
+rename or remove project directories also hold one on the root. A change names the revision the caller last saw
+(``expected_revision``); if the project changed since, :class:`ConflictError` is raised and nothing is written.
+The revision is a hash of the project's files, so it costs nothing in git and follows edits made outside the tool.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import hashlib
+import os
+import shutil
+import tempfile
+from collections.abc import Callable, Iterator
+from dataclasses import dataclass, replace
+from pathlib import Path
+from typing import Protocol
+
+from servostudio.services.projects import layout
+from servostudio.services.projects.devices import axis_files
+from servostudio.services.projects.errors import (
+    ConflictError,
+    ProjectExists,
+    ProjectNotFound,
+    ValidationError,
+)
+from servostudio.services.projects.fsutil import atomic_write, is_same_directory, locked_directory
+from servostudio.services.projects.model import Axis, Bus, Project, from_text, to_text
+from servostudio.services.projects.names import check_name, is_valid_name, same_name
+from servostudio.services.projects.validation import validate_project
+
+
+class DeviceCatalog(Protocol):
+    """What the store needs from the EDS library: the device keys it may reference."""
+
+    def devices(self) -> list[str]: ...
+
+
+@dataclass(frozen=True)
+class Snapshot:
+    """A project as read under its lock, with the revision to pass back with the next change."""
+
+    project: Project
+    revision: str
+
+
+class ProjectEdit:
+    """A project opened for change inside :meth:`ProjectStore.edit`; writes go straight to disk, atomically."""
+
+    def __init__(self, directory: Path, project: Project) -> None:
+        self.directory = directory
+        self.project = project
+        self.revision = ""
+
+    def axis(self, name: str) -> Axis:
+        axis = self.project.axis(name)
+        if axis is None:
+            known = ", ".join(a.name for a in self.project.axes) or "none"
+            raise ProjectNotFound(f"project '{self.project.name}' has no axis '{name}' (axes: {known})")
+        return axis
+
+    def axis_directory(self, name: str) -> Path:
+        return self.directory / self.axis(name).name
+
+    def write_axis_file(self, axis: str, file_name: str, data: bytes) -> None:
+        directory = self.axis_directory(axis)
+        directory.mkdir(exist_ok=True)
+        atomic_write(directory / file_name, data)
+
+    def save(self, project: Project) -> None:
+        atomic_write(self.directory / layout.PROJECT_FILE, to_text(project))
+        self.project = project
+
+
+class ProjectStore:
+    def __init__(self, root: Path, devices: DeviceCatalog) -> None:
+        self.root = Path(root)
+        self._devices = devices
+
+    # ---- projects -------------------------------------------------------------------------------------------
+
+    def names(self) -> list[str]:
+        if not self.root.is_dir():
+            return []
+        return sorted(
+            (entry.name for entry in self.root.iterdir()
+             if is_valid_name(entry.name) and (entry / layout.PROJECT_FILE).is_file()),
+            key=str.casefold,
+        )
+
+    def open(self, name: str) -> Snapshot:
+        with self._project_lock(name, exclusive=False) as directory:
+            return Snapshot(self._read(directory), revision_of(directory))
+
+    def create(self, name: str, description: str = "", buses: tuple[Bus, ...] = ()) -> Snapshot:
+        project = Project(check_name(name, "project"), description, buses)
+        validate_project(project, self._devices.devices())
+        self.root.mkdir(parents=True, exist_ok=True)
+        with self._store_lock():
+            self._refuse_existing(name)
+            with self.staging() as staging:
+                atomic_write(staging / layout.PROJECT_FILE, to_text(project))
+                os.rename(staging, self.root / name)
+            return Snapshot(project, revision_of(self.root / name))
+
+    def update(self, name: str, expected_revision: str | None = None, *, description: str | None = None,
+               buses: tuple[Bus, ...] | None = None) -> Snapshot:
+        with self.edit(name, expected_revision) as edit:
+            project = edit.project
+            if description is not None:
+                project = replace(project, description=description)
+            if buses is not None:
+                project = replace(project, buses=buses)
+            self._validate(project)
+            edit.save(project)
+        return Snapshot(edit.project, edit.revision)
+
+    def rename(self, name: str, new_name: str, expected_revision: str | None = None) -> Snapshot:
+        check_name(new_name, "project")
+        with self._store_lock(), self.edit(name, expected_revision) as edit:
+            if not same_name(name, new_name):
+                self._refuse_existing(new_name)
+            edit.save(replace(edit.project, name=new_name))
+            os.rename(self.root / name, self.root / new_name)
+            edit.directory = self.root / new_name
+        return Snapshot(edit.project, edit.revision)
+
+    def duplicate(self, name: str, new_name: str) -> Snapshot:
+        check_name(new_name, "project")
+        with self._store_lock():
+            self._refuse_existing(new_name)
+            with self._project_lock(name, exclusive=False) as source, self.staging() as staging:
+                shutil.rmtree(staging)
+                shutil.copytree(source, staging, symlinks=True, ignore=_ignore_temporary)
+                copy = replace(self._read(source), name=new_name)
+                atomic_write(staging / layout.PROJECT_FILE, to_text(copy))
+                os.rename(staging, self.root / new_name)
+            return Snapshot(copy, revision_of(self.root / new_name))
+
+    def delete(self, name: str, expected_revision: str | None = None) -> None:
+        with self._store_lock(), self.edit(name, expected_revision) as edit:
+            trash = Path(tempfile.mkdtemp(dir=self.root, prefix=".deleted-"))
+            os.rename(edit.directory, trash / name)
+            edit.directory = trash / name
+        shutil.rmtree(trash)
+
+    # ---- axes -----------------------------------------------------------------------------------------------
+
+    def add_axis(self, name: str, axis: Axis, expected_revision: str | None = None) -> Snapshot:
+        with self.edit(name, expected_revision) as edit:
+            project = edit.project.with_axes((*edit.project.axes, axis))
+            self._validate(project)
+            directory = edit.directory / axis.name
+            if directory.exists():
+                raise ProjectExists(f"'{directory}' already exists but is not an axis of project '{name}';"
+                                    " move it away or choose another axis name")
+            with self.staging(edit.directory) as staging:
+                for file_name in axis_files(axis.device):
+                    atomic_write(staging / file_name, "")
+                os.rename(staging, directory)
+            edit.save(project)
+        return Snapshot(edit.project, edit.revision)
+
+    def edit_axis(self, project: str, axis_name: str, expected_revision: str | None = None,
+                  **changes: object) -> Snapshot:
+        """Change fields of an axis (``name``, ``device``, ``node_id``, ``bus``, ``description``); renaming an axis
+        renames its directory."""
+        unknown = set(changes) - {"name", "device", "node_id", "bus", "description"}
+        if unknown:
+            raise ValidationError(f"cannot change axis field(s) {', '.join(sorted(unknown))} here")
+        with self.edit(project, expected_revision) as edit:
+            old = edit.axis(axis_name)
+            new = replace(old, **changes)
+            project = edit.project.with_axes(tuple(new if axis is old else axis for axis in edit.project.axes))
+            self._validate(project)
+            moving = new.name != old.name and (edit.directory / old.name).is_dir()
+            if moving and (edit.directory / new.name).exists() and not same_name(old.name, new.name):
+                raise ProjectExists(f"'{edit.directory / new.name}' already exists; choose another axis name")
+            if new.device != old.device:
+                _switch_device_files(edit.directory / old.name, old, new.device)
+            if moving:
+                os.rename(edit.directory / old.name, edit.directory / new.name)
+            edit.save(project)
+        return Snapshot(edit.project, edit.revision)
+
+    def replace_axis(self, edit: ProjectEdit, axis: Axis) -> None:
+        """Store changed choices of an axis (motor, application) inside an edit the caller already holds."""
+        project = edit.project.with_axes(tuple(axis if a.name == axis.name else a for a in edit.project.axes))
+        self._validate(project)
+        edit.save(project)
+
+    def remove_axis(self, name: str, axis_name: str, expected_revision: str | None = None) -> Snapshot:
+        with self.edit(name, expected_revision) as edit:
+            removed = edit.axis(axis_name)
+            edit.save(edit.project.with_axes(tuple(a for a in edit.project.axes if a is not removed)))
+            if (edit.directory / removed.name).is_dir():
+                trash = Path(tempfile.mkdtemp(dir=edit.directory, prefix=".deleted-"))
+                os.rename(edit.directory / removed.name, trash / removed.name)
+                shutil.rmtree(trash)
+        return Snapshot(edit.project, edit.revision)
+
+    # ---- building blocks for the other project services -------------------------------------------------------
+
+    @contextlib.contextmanager
+    def edit(self, name: str, expected_revision: str | None = None) -> Iterator[ProjectEdit]:
+        """Lock the project, check the revision, hand out a :class:`ProjectEdit`; its ``revision`` is set on exit."""
+        with self._project_lock(name, exclusive=True) as directory:
+            if expected_revision is not None:
+                actual = revision_of(directory)
+                if actual != expected_revision:
+                    raise ConflictError(name, expected_revision, actual)
+            edit = ProjectEdit(directory, self._read(directory))
+            yield edit
+            edit.revision = revision_of(edit.directory)
+
+    @contextlib.contextmanager
+    def read(self, name: str) -> Iterator[ProjectEdit]:
+        """Hold a shared lock while reading several files of one project consistently."""
+        with self._project_lock(name, exclusive=False) as directory:
+            view = ProjectEdit(directory, self._read(directory))
+            view.revision = revision_of(directory)
+            yield view
+
+    def project_directory(self, name: str) -> Path:
+        check_name(name, "project")
+        return self.root / name
+
+    @contextlib.contextmanager
+    def _store_lock(self) -> Iterator[None]:
+        """Exclusive lock on the store directory, for operations that add, rename or remove project directories."""
+        if not self.root.is_dir():
+            raise ProjectNotFound(f"the project store {self.root} does not exist")
+        with locked_directory(self.root):
+            yield
+
+    @contextlib.contextmanager
+    def _project_lock(self, name: str, exclusive: bool) -> Iterator[Path]:
+        directory = self.project_directory(name)
+        if not (directory / layout.PROJECT_FILE).is_file():
+            raise ProjectNotFound(f"no project '{name}' in {self.root}")
+        with locked_directory(directory, exclusive) as locked:
+            if not is_same_directory(locked, directory):
+                raise ProjectNotFound(f"project '{name}' was renamed or deleted meanwhile")
+            yield directory
+
+    @contextlib.contextmanager
+    def staging(self, parent: Path | None = None) -> Iterator[Path]:
+        """A temporary directory next to the target: renaming it into place is the commit; on error it vanishes."""
+        staging = Path(tempfile.mkdtemp(dir=parent or self.root, prefix=".new-"))
+        staging.chmod(0o755)  # mkdtemp makes it private; a project directory is an ordinary directory
+        try:
+            yield staging
+        finally:
+            shutil.rmtree(staging, ignore_errors=True)
+
+    def adopt(self, directory: Path, name: str, rename: bool,
+              verify: Callable[[Path, Project], None] | None = None) -> None:
+        """Move a complete project directory (built in :meth:`staging`) into the store as ``name``.
+
+        The project file is validated (and ``verify`` may check the axis files), and rewritten only when the
+        project gets a new name, so an unpacked archive is byte-identical to the archived project.
+        """
+        check_name(name, "project")
+        with self._store_lock():
+            self._refuse_existing(name)
+            project = replace(self._read(directory), name=name)
+            self._validate(project)
+            if verify is not None:
+                verify(directory, project)
+            if rename:
+                atomic_write(directory / layout.PROJECT_FILE, to_text(project))
+            os.rename(directory, self.root / name)
+
+    def _read(self, directory: Path) -> Project:
+        path = directory / layout.PROJECT_FILE
+        return from_text(path.read_text(encoding="utf-8"), path, directory.name)
+
+    def _validate(self, project: Project) -> None:
+        validate_project(project, self._devices.devices())
+
+    def _refuse_existing(self, name: str) -> None:
+        for existing in self.root.iterdir():
+            if same_name(existing.name, name):
+                raise ProjectExists(f"'{existing}' already exists; choose another project name")
+
+
+def _switch_device_files(directory: Path, axis: Axis, device: str) -> None:
+    """Give an axis the empty files of another device. Values and sequences belong to one device's dictionary and
+    do not carry over, so an axis whose files hold anything keeps its device."""
+    directory.mkdir(exist_ok=True)
+    files = [path for path in directory.iterdir() if path.is_file() and not path.name.startswith(layout.TEMP_PREFIX)]
+    if any(path.stat().st_size for path in files):
+        raise ValidationError(f"axis '{axis.name}' holds values for device '{axis.device}' in {directory}; "
+                              "add a new axis for the other device instead")
+    wanted = axis_files(device)
+    for path in files:
+        if path.name not in wanted:
+            path.unlink()
+    for file_name in wanted:
+        if not (directory / file_name).exists():
+            atomic_write(directory / file_name, "")
+
+
+def revision_of(directory: Path) -> str:
+    """Hash of every file of the project (paths and contents): changes whenever anything in the project changes."""
+    digest = hashlib.sha256()
+    for path in sorted(_project_files(directory)):
+        relative = path.relative_to(directory).as_posix()
+        digest.update(relative.encode() + b"\0" + path.read_bytes() + b"\0")
+    return digest.hexdigest()[:16]
+
+
+def _project_files(directory: Path) -> Iterator[Path]:
+    """The regular files of a project; temporary entries and symbolic links are not part of it."""
+    for current, dirs, files in os.walk(directory):
+        dirs[:] = [d for d in dirs if not d.startswith(layout.TEMP_PREFIX)]
+        for file_name in files:
+            path = Path(current) / file_name
+            if not file_name.startswith(layout.TEMP_PREFIX) and not path.is_symlink() and path.is_file():
+                yield path
+
+
+def _ignore_temporary(_directory: str, names: list[str]) -> list[str]:
+    return [name for name in names if name.startswith(layout.TEMP_PREFIX)]

@@ -1,0 +1,116 @@
+"""Scan: find every node of a bus in well under a second and identify it.
+
+All nodes are probed at once (an SDO read of 0x1000 per node, short timeout, no abort to silent nodes, a second
+round for the silent ones); the
+responders are then identified in parallel (0x1018 identity, 0x1008/0x1009/0x100A names and versions) and matched
+to a device dictionary of the EDS library.  A serial link only reaches nodes 1–63 (the redirection range).
+XtrapulsPac drives also answer on 0x600+(n+64), their redirected channel; such an echo of node n is not
+reported as node n+64.
+"""
+
+from __future__ import annotations
+
+from concurrent.futures import Future
+
+from servostudio.drive.sdo import SdoAbortError, SdoError
+from servostudio.od.datatypes import DataType, decode
+from servostudio.services.bus.connections import BusConnection, NodeInfo
+
+PROBE_TIMEOUT = 0.15
+PROBE_ROUNDS = 2
+REDIRECT_OFFSET = 64
+SERIAL_PROBE_TIMEOUT = 0.4
+_IDENTITY = {
+    "vendor_id": (0x1018, 1, DataType.UNSIGNED32),
+    "product_code": (0x1018, 2, DataType.UNSIGNED32),
+    "revision": (0x1018, 3, DataType.UNSIGNED32),
+    "serial_number": (0x1018, 4, DataType.UNSIGNED32),
+    "device_name": (0x1008, 0, DataType.VISIBLE_STRING),
+    "hardware_version": (0x1009, 0, DataType.VISIBLE_STRING),
+    "software_version": (0x100A, 0, DataType.VISIBLE_STRING),
+}
+
+
+def scan(connection: BusConnection, nodes: range | list[int] | None = None) -> list[NodeInfo]:
+    """Probe, identify and remember the nodes present among ``nodes`` (default: every node ID)."""
+    serial = connection.spec.kind == "serial"
+    candidates = list(nodes) if nodes is not None else list(range(1, 64 if serial else 128))
+    timeout = SERIAL_PROBE_TIMEOUT if serial else PROBE_TIMEOUT
+    engine = connection.engine
+    present: dict[int, object] = {}
+    for _ in range(PROBE_ROUNDS):  # a second round catches a node whose first answer was lost or late
+        probes = {node: engine.upload(node, 0x1000, 0, timeout=timeout, probe=True)
+                  for node in candidates if node not in present}
+        present.update({node: _value(future, DataType.UNSIGNED32) for node, future in probes.items()
+                        if _answered(future)})
+    for node in [node for node in present if node > REDIRECT_OFFSET and node - REDIRECT_OFFSET in present]:
+        del present[node]  # 0x600+(n+64) is node n's redirected SDO channel, not another node
+    found = [_identify(connection, node, device_type) for node, device_type in sorted(present.items())]
+    if nodes is None:
+        connection.nodes = {}
+    for node in candidates:
+        connection.nodes.pop(node, None)
+    connection.nodes.update({info.node: info for info in found})
+    connection.events.publish({"type": "scan", "bus": connection.id, "nodes": [info.as_dict() for info in found]})
+    return found
+
+
+def identify(connection: BusConnection, node: int) -> NodeInfo | None:
+    """Identify one node (or None if it does not answer) and remember it."""
+    for _ in range(PROBE_ROUNDS):
+        probe = connection.engine.upload(node, 0x1000, 0, probe=True)
+        if _answered(probe):
+            break
+    else:
+        return None
+    info = _identify(connection, node, _value(probe, DataType.UNSIGNED32))
+    connection.nodes[node] = info
+    return info
+
+
+def _identify(connection: BusConnection, node: int, device_type: object) -> NodeInfo:
+    requests = {name: (connection.engine.upload(node, index, sub), data_type)
+                for name, (index, sub, data_type) in _IDENTITY.items()}
+    values = {name: _value(future, data_type) for name, (future, data_type) in requests.items()}
+    info = NodeInfo(node=node, device_type=device_type if isinstance(device_type, int) else None, **values)
+    if info.vendor_id is not None:
+        info.device = connection.library.match(info.vendor_id, info.product_code or 0)
+    cob_id = _statusword_pdo(connection, node)
+    if cob_id is not None and connection.monitor is not None:
+        connection.monitor.watch_statusword(node, cob_id)
+    return info
+
+
+def _statusword_pdo(connection: BusConnection, node: int) -> int | None:
+    """COB-ID of a valid TPDO whose first mapped object is the status word 0x6041 (None if there is none)."""
+    engine = connection.engine
+    requests = [(engine.upload(node, 0x1800 + pdo, 1), engine.upload(node, 0x1A00 + pdo, 1)) for pdo in range(4)]
+    for communication, mapping in requests:
+        cob_id, first = _value(communication, DataType.UNSIGNED32), _value(mapping, DataType.UNSIGNED32)
+        if isinstance(cob_id, int) and isinstance(first, int) and first >> 16 == 0x6041 and not cob_id & 0x80000000:
+            return cob_id & 0x7FF
+    return None
+
+
+def _answered(future: Future) -> bool:
+    """A node is present when it answered at all — an abort is an answer too."""
+    try:
+        future.result()
+    except SdoAbortError:
+        return True
+    except SdoError:
+        return False
+    return True
+
+
+def _value(future: Future, data_type: DataType) -> int | str | None:
+    try:
+        raw = future.result()
+    except SdoError:
+        return None
+    size = data_type.size
+    try:
+        value = decode(data_type, raw[:size] if size else raw)
+    except ValueError:
+        return None
+    return value.rstrip("\0") if isinstance(value, str) else value

@@ -1,0 +1,95 @@
+"""Dialog terminal (manual §2.7): read or write any object on up to 4 axes at once, with continuous monitoring.
+
+A ``Watch`` is the list of objects the terminal shows; ``sample`` reads them all in one go (reads of different
+nodes run in parallel, reads of one node back to back) and returns one row per object, each with its value or
+the error that object gave, so a missing drive does not blank the other axes.
+"""
+
+from __future__ import annotations
+
+from concurrent.futures import Future
+from dataclasses import dataclass
+
+from servostudio.drive.access import Drive, DriveAccessError
+from servostudio.drive.sdo import SdoError
+from servostudio.services.bus.connections import ConnectionManager
+
+MAX_AXES = 4
+MAX_ITEMS = 32
+MIN_PERIOD = 0.05
+
+
+class TerminalError(ValueError):
+    """A watch list the terminal refuses (too many axes, unknown bus/object)."""
+
+
+@dataclass(frozen=True)
+class WatchItem:
+    bus: str
+    node: int
+    object: str
+
+
+@dataclass(frozen=True)
+class Watch:
+    items: tuple[WatchItem, ...]
+    period: float = 0.2
+
+    def __post_init__(self) -> None:
+        axes = {(item.bus, item.node) for item in self.items}
+        if len(axes) > MAX_AXES:
+            raise TerminalError(f"the terminal works on up to {MAX_AXES} axes at once, got {len(axes)}")
+        if len(self.items) > MAX_ITEMS:
+            raise TerminalError(f"at most {MAX_ITEMS} objects can be watched, got {len(self.items)}")
+        if self.period < MIN_PERIOD:
+            raise TerminalError(f"monitoring period must be at least {MIN_PERIOD * 1000:.0f} ms")
+
+
+def sample(manager: ConnectionManager, watch: Watch, timeout: float = 2.0) -> list[dict[str, object]]:
+    """Read every watched object once; one row per item with ``value`` or ``error``."""
+    pending: list[tuple[WatchItem, Future | None, str]] = []
+    for item in watch.items:
+        try:
+            drive = manager.get(item.bus).drive(item.node)
+            pending.append((item, drive.submit_read(drive.variable(item.object)), ""))
+        except (LookupError, DriveAccessError) as error:
+            pending.append((item, None, str(error)))
+    rows = []
+    for item, future, error in pending:
+        row: dict[str, object] = {"bus": item.bus, "node": item.node, "object": item.object}
+        if future is None:
+            row["error"] = error
+        else:
+            try:
+                row["value"] = future.result(timeout).as_dict()
+            except (SdoError, ValueError, TimeoutError) as failure:
+                row["error"] = str(failure)
+        rows.append(row)
+    return rows
+
+
+def write(manager: ConnectionManager, bus: str, node: int, key: str, value: object, physical: bool = False,
+          ) -> dict[str, object]:
+    """Write one object (checked against the dictionary first) and return what was written."""
+    drive = manager.get(bus).drive(node)
+    return drive.write(key, value, physical).as_dict()
+
+
+def read_objects(drive: Drive, keys: list[str], timeout: float = 5.0) -> list[dict[str, object]]:
+    """Read many objects of one node, queued back to back; one row per key with ``value`` or ``error``."""
+    pending: list[tuple[str, Future | None, str]] = []
+    for key in keys:
+        try:
+            pending.append((key, drive.submit_read(drive.variable(key)), ""))
+        except DriveAccessError as error:
+            pending.append((key, None, str(error)))
+    rows = []
+    for key, future, error in pending:
+        row: dict[str, object] = {"object": key, "value": None, "error": error or None}
+        if future is not None:
+            try:
+                row["value"] = future.result(timeout).as_dict()
+            except (SdoError, ValueError, TimeoutError) as failure:
+                row["error"] = str(failure)
+        rows.append(row)
+    return rows

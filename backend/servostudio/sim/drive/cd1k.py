@@ -1,0 +1,144 @@
+"""Infranor CD1-k on the shared engine (seed 001, /work/shared/spec/cd1k-canopen.md).
+
+Differences from the XtrapulsPac that the simulation reproduces:
+- positions in increments with 0x608F,1 increments per revolution (no factor group), speeds inc/s;
+- currents in % of the drive rating 0x6510,4 (0.01 A) with 0x3FFF = 100 %: 0x6510,5 max, 0x6510,6 rated;
+- commutation data in 0x6410,2..4 (phase order 0/1), auto-phasing 'apha' on 0x3410, motor phasing 'mcal' on 0x3414,
+  auto-tuning 'atun' on 0x3420,2 with bandwidth 0x3420,1;
+- the gain records have other sub-indices (0x60F6,1..4 q/d, 0x60F9,1 KP … 0x60FB,1 KPp …);
+- errors in the 0x3020 bit field (EMCY bytes 3–6), fault reactions by the masks 0x3330 (Stop 1) / 0x3331 (Stop 3);
+- no halt bit; default mode ip (7).
+The scalings of the gains are the project's (docs/control-loops.md), as for the XtrapulsPac.
+"""
+
+from __future__ import annotations
+
+from servostudio.sim.drive import errors
+from servostudio.sim.drive.behaviour import DriveBehaviour
+from servostudio.sim.drive.errors import DriveError
+from servostudio.sim.drive.profile import _COMMON_402, DeviceProfile
+from servostudio.sim.drive.statemachine import STOP_CURRENT_LIMIT, STOP_NONE, STOP_SLOW_DOWN_RAMP
+from servostudio.sim.drive.units import UnitScaling
+
+FULL_SCALE = 0x3FFF
+
+CD1K = DeviceProfile(
+    key="cd1k",
+    objects={
+        name: address for name, address in _COMMON_402.items()
+        if address[0] not in (0x60F6, 0x60F9, 0x60FB, 0x6410, 0x6510, 0x6093, 0x6073, 0x6075)
+    } | {
+        "kp_current_q": (0x60F6, 1),
+        "ki_current_q": (0x60F6, 2),
+        "kp_current_d": (0x60F6, 3),
+        "ki_current_d": (0x60F6, 4),
+        "kp_speed": (0x60F9, 1),
+        "ki_speed": (0x60F9, 2),
+        "kc_speed": (0x60F9, 4),
+        "kd_speed": (0x60F9, 7),
+        "kp_position": (0x60FB, 1),
+        "kf_position": (0x60FB, 2),
+        "ka_position": (0x60FB, 3),
+        "kb_position": (0x60FB, 4),
+        "control_pole_pairs": (0x6410, 2),
+        "control_phase": (0x6410, 3),
+        "control_offset": (0x6410, 4),
+        "drive_rating": (0x6510, 4),
+        "max_current_share": (0x6510, 5),
+        "rated_current_share": (0x6510, 6),
+        "i2t_mode": (0x6510, 7),
+        "error_bits": (0x3020, 0),
+        "warning_word": (0x3021, 0),
+        "fault_reaction_stop1": (0x3330, 0),
+        "fault_reaction_stop3": (0x3331, 0),
+        "inhibit_code": (0x305A, 0),
+        "homing_current_limit": (0x309C, 0),
+        "dynamic_current_limit": (0x30D1, 0),
+        "current_monitor": (0x30D4, 0),
+        "homing_indicator": (0x3217, 0),
+        "slow_down_ramp": (0x3300, 1),
+        "stop_current_limit": (0x3301, 0),
+        "drive_reaction_time": (0x3304, 0),
+        "brake_reaction_time": (0x3305, 0),
+        "tuning_bandwidth": (0x3420, 1),
+        "tuning_requirement": (0x3430, 0),
+    },
+    modes=frozenset({1, 3, 4, 6, 7}),
+    procedures={"apha": (0x3410, 0), "mcal": (0x3414, 0), "atun": (0x3420, 2)},
+    supported_modes_word=0x6D,
+    default_mode=7,
+    halt_bit=False,
+)
+
+# Infranor (XtrapulsPac) code → 0x3020 bit value of the CD1-k
+_ERROR_BITS = {
+    errors.SOFTWARE_LIMIT.code: 1 << 0,
+    errors.I2T.code: 1 << 1,
+    errors.ENCODER_COUNTING.code: 1 << 2,
+    errors.POSITION_FOLLOWING.code: 1 << 3,
+    errors.SPEED_FOLLOWING.code: 1 << 3,
+    errors.SYNC_CYCLE.code: 1 << 5,
+    errors.GUARDING.code: 1 << 5,
+    errors.PROCEDURE.code: 1 << 7,
+    errors.STOP_FAILED.code: 1 << 7,
+    errors.MOTOR_TEMPERATURE.code: 1 << 13,
+    errors.OVERCURRENT.code: 1 << 15,
+    errors.OVERVOLTAGE.code: 0b010 << 16,
+    errors.MOTOR_BRAKE.code: 0b111 << 16,
+    errors.UNDERVOLTAGE.code: 1 << 20,
+}
+_PHASE_ORDER = {1: 0, -1: 1}
+
+
+class Cd1kBehaviour(DriveBehaviour):
+    def read_units(self) -> UnitScaling:
+        increments = float(self.p.get("encoder_increments", 0)) or float(self.physics.counts_per_turn)
+        return UnitScaling(increments)
+
+    def read_currents(self) -> tuple[float, float, float]:
+        rating = float(self.p.get("drive_rating", 0)) * 0.01 or self.plant.peak_current
+        maximum = float(self.p.get("max_current_share", FULL_SCALE)) / FULL_SCALE * rating or rating
+        rated = float(self.p.get("rated_current_share", FULL_SCALE // 2)) / FULL_SCALE * rating or rating / 2
+        return rating, rated, maximum
+
+    def phase_sign_of(self, value: int) -> int:
+        return -1 if value == 1 else 1
+
+    def phase_value(self, sign: int) -> int:
+        return _PHASE_ORDER[1 if sign > 0 else -1]
+
+    def apply_commissioning(self) -> None:
+        """Shares of the drive rating instead of mA; then the common values (commutation, gains)."""
+        rating = float(self.p.get("drive_rating", 0)) * 0.01
+        if rating > 0:
+            plant = self.plant
+            self.write("max_current_share", min(FULL_SCALE, round(plant.peak_current / rating * FULL_SCALE)))
+            self.write("rated_current_share", min(FULL_SCALE // 2, round(plant.stall_current / rating * FULL_SCALE)))
+            self.write("max_motor_speed", min(25000, plant.max_speed_rpm))
+        super().apply_commissioning()
+
+    def error_inhibited(self, error: DriveError) -> bool:
+        return False
+
+    def fault_reaction(self, error: DriveError) -> int:
+        bit = _ERROR_BITS.get(error.code, 0)
+        if bit & int(self.p.get("fault_reaction_stop3", 0)):
+            return STOP_CURRENT_LIMIT
+        if bit & int(self.p.get("fault_reaction_stop1", 0)):
+            return STOP_SLOW_DOWN_RAMP
+        return STOP_NONE
+
+    def send_emergency(self, error: DriveError) -> None:
+        """EMCY bytes 3–6 carry the 0x3020 drive error code (LSB first)."""
+        value = self._error_bits()
+        self.events.emergency(error.cia_code, value & 0xFF, (value >> 8).to_bytes(3, "little"))
+
+    def _error_bits(self) -> int:
+        value = 0
+        for code in self.active_errors:
+            value |= _ERROR_BITS.get(code, 0)
+        return value
+
+    def _publish_errors(self, latest: DriveError | None) -> None:
+        self.write("error_bits", self._error_bits())
+        self.write("error_code", latest.cia_code if latest else 0)

@@ -1,0 +1,95 @@
+"""TR-Electronic encoTRive MD-025 on the shared engine (seed 004, /work/shared/spec/encotrive-canopen.md).
+
+A motor-integrated positioning drive: factory-calibrated commutation and loops (no phasing, tuning or current
+loop objects), profile position and profile velocity only, no homing (absolute measuring system), position
+units through 0x6093 numerator/divisor on 0x608F,1 increments per revolution, speeds in rpm and accelerations in
+rpm/s (the factory setting of the velocity factor), following error with window 0x6065 and time-out 0x6066,
+writable actual position 0x6064 (preset), DS-301 EMCY codes without an Infranor byte, error history 0x1003.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from servostudio.sim.drive import gains
+from servostudio.sim.drive.behaviour import DriveBehaviour
+from servostudio.sim.drive.commissioning import COMMISSIONING_BANDWIDTH_HZ
+from servostudio.sim.drive.errors import DriveError
+from servostudio.sim.drive.profile import _COMMON_402, DeviceProfile
+from servostudio.sim.drive.statemachine import STOP_NONE, STOP_QUICK_STOP_RAMP
+from servostudio.sim.drive.units import RPM, UnitScaling
+
+ENCOTRIVE = DeviceProfile(
+    key="encotrive",
+    objects={
+        name: address for name, address in _COMMON_402.items()
+        if address[0] not in (0x60F6, 0x60F9, 0x60FB, 0x6410, 0x6510, 0x6098, 0x6099, 0x609A, 0x607C)
+    } | {"fault_reaction_code": (0x605E, 0), "max_torque": (0x6072, 0)},
+    modes=frozenset({1, 3}),
+    supported_modes_word=0x05,
+    default_mode=1,
+)
+
+
+class EncoTriveBehaviour(DriveBehaviour):
+    def __init__(self, *args: Any, **kwargs: Any) -> None:
+        super().__init__(*args, **kwargs)
+        address = self.profile.address("position_actual")
+        if address is not None and address in self.store:
+            self.store.on_write(address[0], address[1], self._preset_position)
+
+    def _preset_position(self, index: int, sub: int, value: Any) -> None:
+        """Writing 0x6064 sets the current position to `value` (absolute system preset)."""
+        self.position_offset_user = float(value) - self.units.to_user(self.loops.position)
+
+    def read_units(self) -> UnitScaling:
+        increments = float(self.p.get("encoder_increments", 4096)) or 4096.0
+        numerator = float(self.p.get("position_factor_numerator", 1)) or 1.0
+        divisor = float(self.p.get("position_factor_denominator", 1)) or 1.0
+        return UnitScaling(increments * divisor / numerator, speed_unit_rad=RPM, accel_unit_rad=RPM)
+
+    def read_currents(self) -> tuple[float, float, float]:
+        plant = self.plant
+        rated = float(self.p.get("rated_current", 0)) / 1000.0 or plant.stall_current
+        maximum = float(self.p.get("max_current", 0)) / 1000.0 * rated or plant.peak_current
+        return plant.peak_current, rated, min(maximum, plant.peak_current)
+
+    def apply_commissioning(self) -> None:
+        """Nothing to commission: the factory calibration matches the motor."""
+        self.phasing_valid = True
+
+    def refresh_parameters(self) -> None:
+        """The loops run with the factory calibration of the integrated motor."""
+        super().refresh_parameters()
+        plant = self.plant
+        loops = self.loops
+        loops.pole_pairs = plant.pole_pairs
+        loops.phase_sign = plant.phase_sign
+        loops.offset_turns = plant.sensor_offset / 65536.0
+        loops.emf_constant = plant.torque_constant / 1.5
+        current = gains.current_loop_gains(plant.inductance, 0)
+        loops.kp_q = loops.kp_d = current.kp_q * gains.CURRENT_KP_UNIT
+        loops.ki_q = loops.ki_d = current.ki_q * gains.CURRENT_KI_UNIT
+        tuned = gains.tuned_gains(plant.total_inertia, plant.torque_constant, COMMISSIONING_BANDWIDTH_HZ,
+                                  viscous_friction=plant.viscous_friction)
+        scale = tuned.kjv / gains.KJV_ONE
+        loops.kpv = tuned.kpv * gains.KPV_UNIT * scale
+        loops.kiv = tuned.kiv * gains.KIV_UNIT * scale
+        loops.kbv = tuned.kbv * gains.KPV_UNIT * scale
+        loops.kav = tuned.kav * gains.KAV_UNIT * scale
+        loops.kpp = tuned.kpp * gains.KPP_UNIT
+        loops.kfp = tuned.kfp / gains.KFP_FULL
+
+    def fault_reaction(self, error: DriveError) -> int:
+        """0x605E: 0 switch off, 1/2 decelerate (quick-stop ramp here), 3 current limit."""
+        code = int(self.p.get("fault_reaction_code", 0))
+        return STOP_QUICK_STOP_RAMP if code in (1, 2, 3) else STOP_NONE
+
+    def error_inhibited(self, error: DriveError) -> bool:
+        return False
+
+    def send_emergency(self, error: DriveError) -> None:
+        self.events.emergency(error.cia_code)
+
+    def _publish_errors(self, latest: DriveError | None) -> None:
+        self.write("error_code", latest.cia_code if latest else 0)

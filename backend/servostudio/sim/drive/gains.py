@@ -1,0 +1,126 @@
+"""Scalings of the regulator gains (0x60F6, 0x60F9, 0x60FB) and the tuning formulas built on them.
+
+The manual gives no scaling (decisions.md §5): these definitions are the project's, written down with the same
+formulas in docs/control-loops.md so the tool's tuning computes exactly what the simulated drive uses.
+Physical units: A (d/q amplitude), V, rad and rad/s of the motor shaft, s.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+CURRENT_KP_UNIT = 0.01
+"""0x60F6,2 / ,4: current-loop proportional gain, V/A per count."""
+CURRENT_KI_UNIT = 10.0
+"""0x60F6,3 / ,5: current-loop integral gain, V/(A·s) per count."""
+CURRENT_BANDWIDTH_HZ = {0: 500.0, 1: 250.0}
+"""Current-loop bandwidth used by 'calc' for regulator type 0x60F6,1 = 0 (high) and 1 (low)."""
+
+KPV_UNIT = 1e-4
+"""0x60F9,2 KPv and 0x60F9,5 KCv and 0x60FB,5 KBv: A per rad/s."""
+KIV_UNIT = 1e-2
+"""0x60F9,3 KIv: A per rad (per integrated rad/s)."""
+KIVF_UNIT_HZ = 0.1
+"""0x60F9,4 KIvf: integrator leak corner, 0.1 Hz."""
+KDV_UNIT = 1e-6
+"""0x60F9,6 KDv: A per rad/s² (not scaled by KJv)."""
+KJV_ONE = 256
+"""0x60F9,8 KJv: multiplier KJv/256 on KPv, KIv, KCv, KBv, KAv."""
+KPP_UNIT = 0.01
+"""0x60FB,2 KPp: (rad/s) per rad, i.e. 1/s."""
+KFP_FULL = 65535
+"""0x60FB,3 KFp: speed feed-forward fraction KFp/65535."""
+KAV_UNIT = 1e-6
+"""0x60FB,4 KAv: A per rad/s² (scaled by KJv)."""
+
+SPEED_FILTER_TAU = {0: 0.5e-3, 1: 1e-3, 2: 2e-3}
+"""0x30FA: first-order speed-measurement filter time constant, s."""
+TUNING_BANDWIDTH_HZ = {0: 50.0, 1: 75.0, 2: 100.0}
+"""0x3425,1: auto-tuning speed-loop bandwidth."""
+U16_MAX = 0xFFFF
+
+
+@dataclass(frozen=True)
+class CurrentGains:
+    """Raw 0x60F6,2..5 values."""
+
+    kp_q: int
+    ki_q: int
+    kp_d: int
+    ki_d: int
+
+
+def current_loop_gains(inductance_pp: float, regulator_type: int) -> CurrentGains:
+    """'calc': Kp = Lφ·ωc, Ki = Kp·ωc/4 with Lφ = phase-to-phase inductance / 2, ωc = 2π·f (500 / 250 Hz)."""
+    omega = 2.0 * math.pi * CURRENT_BANDWIDTH_HZ.get(regulator_type, CURRENT_BANDWIDTH_HZ[0])
+    kp = inductance_pp / 2.0 * omega
+    ki = kp * omega / 4.0
+    kp_raw = _u16(kp / CURRENT_KP_UNIT)
+    ki_raw = _u16(ki / CURRENT_KI_UNIT)
+    return CurrentGains(kp_raw, ki_raw, kp_raw, ki_raw)
+
+
+@dataclass(frozen=True)
+class SpeedPositionGains:
+    """Raw values of 0x60F9,2..8, 0x60FB,2..5 and 0x30FA chosen by tuning."""
+
+    kpv: int
+    kiv: int
+    kivf: int
+    kcv: int
+    kdv: int
+    kdvf: int
+    kjv: int
+    kpp: int
+    kfp: int
+    kav: int
+    kbv: int
+    speed_filter: int
+
+
+def tuned_gains(
+    inertia: float,
+    torque_constant: float,
+    bandwidth_hz: float,
+    *,
+    position_loop: bool = True,
+    minimum_following_error: bool = True,
+    viscous_friction: float = 0.0,
+) -> SpeedPositionGains:
+    """The auto-tuning rule (docs/control-loops.md):
+
+    ω = 2π·bandwidth; KPv = J·ω/Kt; KIv = KPv·ω/4; KCv = 0; KPp = ω/5;
+    minimum following error: KFp = full, KBv = KCv + B/Kt (viscous compensation), KAv = J/Kt;
+    minimum overshoot: KFp = KBv = KAv = 0; a velocity-mode tuning leaves the position gains at 0.
+    KJv is the smallest power-of-two multiple of 256 that keeps every scaled gain within U16.
+    """
+    omega = 2.0 * math.pi * bandwidth_hz
+    kpv = inertia * omega / torque_constant
+    kiv = kpv * omega / 4.0
+    kav = inertia / torque_constant if minimum_following_error else 0.0
+    kbv = viscous_friction / torque_constant if minimum_following_error else 0.0
+    scaled = (kpv / KPV_UNIT, kiv / KIV_UNIT, kav / KAV_UNIT, kbv / KPV_UNIT)
+    kjv = KJV_ONE
+    while max(scaled) * KJV_ONE / kjv > U16_MAX and kjv < U16_MAX // 2:
+        kjv *= 2
+    factor = KJV_ONE / kjv
+    kpp = omega / 5.0 / KPP_UNIT if position_loop else 0.0
+    return SpeedPositionGains(
+        kpv=_u16(kpv / KPV_UNIT * factor),
+        kiv=_u16(kiv / KIV_UNIT * factor),
+        kivf=0,
+        kcv=0,
+        kdv=0,
+        kdvf=0,
+        kjv=kjv,
+        kpp=_u16(kpp),
+        kfp=KFP_FULL if (position_loop and minimum_following_error) else 0,
+        kav=_u16(kav / KAV_UNIT * factor) if position_loop else 0,
+        kbv=_u16(kbv / KPV_UNIT * factor) if position_loop else 0,
+        speed_filter=0 if bandwidth_hz >= 75.0 else 1,
+    )
+
+
+def _u16(value: float) -> int:
+    return max(0, min(U16_MAX, round(value)))

@@ -1,0 +1,210 @@
+"""Procedures started by writing a 4-character signature (decisions.md §4) and the drive-side algorithms.
+
+Status read back from the trigger object: 0 never executed, 1 cannot execute, 2 running, 3 aborted, 4 stopped on
+error, 5 done. Status word bit 15 is set while one runs; a failure raises error 64 "procedure error".
+
+Auto-phasing ('apha') identifies pole pairs, phase order and sensor offset from the motor itself: it injects a
+d-axis current vector at a forced electrical angle, turns that angle slowly forward until the sensor has seen
+one mechanical revolution (pole pairs = electrical turns / mechanical turns, the sign gives the phase order),
+turns it back, and takes the offset as the circular mean of S·φ/2π − pp·turns over both sweeps (forward and
+backward lag from friction cancel). Motor phasing ('mcal') finds only the offset with pole pairs and phase
+order already known, with a ±1 electrical turn sweep.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+from servostudio.sim.drive.physics import TWO_PI
+
+NEVER_EXECUTED = 0
+CANNOT_EXECUTE = 1
+RUNNING = 2
+ABORTED = 3
+FAILED = 4
+DONE = 5
+
+
+def signature(text: str) -> int:
+    """'apha' → 0x61687061: four ASCII characters as a little-endian U32."""
+    return int.from_bytes(text.encode("ascii"), "little")
+
+
+class ProcedureSlot:
+    """Status of one trigger object."""
+
+    def __init__(self, name: str) -> None:
+        self.name = name
+        self.status = NEVER_EXECUTED
+
+    @property
+    def running(self) -> bool:
+        return self.status == RUNNING
+
+
+@dataclass
+class PhasingResult:
+    pole_pairs: int
+    phase_sign: int
+    offset: int  # 0x3410,3: 65536 = one electrical turn
+
+
+class ForcedVectorSweep:
+    """Common machinery: align, then sweep the forced angle and sample (angle, sensor turns)."""
+
+    ALIGN_TIME = 0.3
+    ELECTRICAL_RATE = TWO_PI * 4.0  # rad/s of the forced angle
+    RAMP_TIME = 0.2
+
+    def __init__(self, dt: float, current: float) -> None:
+        self.dt = dt
+        self.current = current
+        self.angle = 0.0
+        self.time = 0.0
+        self.samples: list[tuple[float, float]] = []
+        self._rate = 0.0
+
+    def ramp_rate(self, direction: int) -> None:
+        """Slew the sweep speed so the rotor is not kicked into oscillation."""
+        target = direction * self.ELECTRICAL_RATE
+        step = self.ELECTRICAL_RATE * self.dt / self.RAMP_TIME
+        if abs(target - self._rate) <= step:
+            self._rate = target
+        else:
+            self._rate += math.copysign(step, target - self._rate)
+        self.angle += self._rate * self.dt
+
+    def sample(self, turns: float) -> None:
+        self.samples.append((self.angle, turns))
+
+
+def circular_offset(samples: list[tuple[float, float]], pole_pairs: int, phase_sign: int) -> tuple[float, float]:
+    """Offset in electrical turns (0..1) and the mean resultant length (1 = all samples agree)."""
+    x = y = 0.0
+    for angle, turns in samples:
+        value = TWO_PI * (phase_sign * angle / TWO_PI - pole_pairs * turns)
+        x += math.cos(value)
+        y += math.sin(value)
+    count = max(len(samples), 1)
+    return (math.atan2(y, x) / TWO_PI) % 1.0, math.hypot(x, y) / count
+
+
+class AutoPhasing:
+    """'apha'. Drive it with `step(turns)`; read `angle`/`current` for the forced vector each period."""
+
+    MAX_ELECTRICAL_TURNS = 26
+    MIN_AGREEMENT = 0.95
+
+    def __init__(self, dt: float, current: float) -> None:
+        self.sweep = ForcedVectorSweep(dt, current)
+        self.result: PhasingResult | None = None
+        self.failed_reason = ""
+        self._phase = "align"
+        self._start_turns = 0.0
+        self._electrical_turns = 0.0
+        self._direction = 1
+        self._count = 0
+
+    @property
+    def angle(self) -> float:
+        return self.sweep.angle
+
+    @property
+    def current(self) -> float:
+        return self.sweep.current
+
+    def step(self, turns: float) -> bool:
+        """Advance one period with the sensor position in mechanical turns; True when finished."""
+        sweep = self.sweep
+        sweep.time += sweep.dt
+        self._count += 1
+        if self._phase == "align":
+            if sweep.time >= sweep.ALIGN_TIME:
+                self._phase = "forward"
+                self._start_turns = turns
+            return False
+        if self._phase == "forward":
+            sweep.ramp_rate(+1)
+            if self._count % 8 == 0:
+                sweep.sample(turns)
+            moved = turns - self._start_turns
+            if abs(moved) >= 1.0:
+                self._electrical_turns = sweep.angle / TWO_PI
+                self._direction = 1 if moved > 0 else -1
+                self._phase = "backward"
+            elif sweep.angle / TWO_PI > self.MAX_ELECTRICAL_TURNS:
+                return self._fail("the shaft did not follow the rotating field (blocked or loaded?)")
+            return False
+        if self._phase == "backward":
+            sweep.ramp_rate(-1)
+            if self._count % 8 == 0:
+                sweep.sample(turns)
+            if sweep.angle <= 0.0:
+                sweep.angle = 0.0
+                return self._finish()
+            return False
+        return True
+
+    def _finish(self) -> bool:
+        pole_pairs = round(self._electrical_turns)
+        if not 1 <= pole_pairs <= 24:
+            return self._fail(f"implausible pole pairs {self._electrical_turns:.2f}")
+        offset, agreement = circular_offset(self.sweep.samples, pole_pairs, self._direction)
+        if agreement < self.MIN_AGREEMENT:
+            return self._fail(f"the rotor did not follow the field evenly (agreement {agreement:.2f})")
+        self.result = PhasingResult(pole_pairs, self._direction, round(offset * 65536) % 65536)
+        self._phase = "done"
+        return True
+
+    def _fail(self, reason: str) -> bool:
+        self.failed_reason = reason
+        self._phase = "done"
+        return True
+
+
+class MotorPhasing:
+    """'mcal': offset only, with known pole pairs and phase order (±1 electrical turn around the start)."""
+
+    MIN_AGREEMENT = 0.95
+
+    def __init__(self, dt: float, current: float, pole_pairs: int, phase_sign: int) -> None:
+        self.sweep = ForcedVectorSweep(dt, current)
+        self.pole_pairs = pole_pairs
+        self.phase_sign = phase_sign
+        self.result: PhasingResult | None = None
+        self.failed_reason = ""
+        self._phase = "align"
+        self._count = 0
+
+    @property
+    def angle(self) -> float:
+        return self.sweep.angle
+
+    @property
+    def current(self) -> float:
+        return self.sweep.current
+
+    def step(self, turns: float) -> bool:
+        sweep = self.sweep
+        sweep.time += sweep.dt
+        self._count += 1
+        if self._phase == "align":
+            if sweep.time >= sweep.ALIGN_TIME:
+                self._phase = "forward"
+            return False
+        direction = 1 if self._phase == "forward" else -1
+        sweep.ramp_rate(direction)
+        if self._count % 8 == 0:
+            sweep.sample(turns)
+        if self._phase == "forward" and sweep.angle >= TWO_PI:
+            self._phase = "backward"
+        elif self._phase == "backward" and sweep.angle <= 0.0:
+            sweep.angle = 0.0
+            offset, agreement = circular_offset(sweep.samples, self.pole_pairs, 1)
+            if agreement < self.MIN_AGREEMENT:
+                self.failed_reason = f"the rotor did not follow the field (agreement {agreement:.2f})"
+            else:
+                self.result = PhasingResult(self.pole_pairs, self.phase_sign, round(offset * 65536) % 65536)
+            return True
+        return False

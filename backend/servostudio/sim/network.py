@@ -1,0 +1,217 @@
+"""`SimulatedNetwork`: the simulated drives of one CAN bus, the clock that drives them, and the ways in.
+
+Two ways to run time:
+- tests call `advance(seconds)`: deterministic, as fast as the host allows;
+- servers call `start()`: a background thread paces virtual time against the monotonic wall clock (events due are
+  run in batches about every millisecond). When the host cannot keep up for more than `MAX_LAG` seconds, virtual
+  time slips (it runs slower than the wall clock) instead of trying to catch up in a burst.
+All access to the simulation goes through `lock`; frames from outside enter with `inject`.
+"""
+
+from __future__ import annotations
+
+import logging
+import threading
+import time
+from collections.abc import Callable, Iterable
+from dataclasses import dataclass
+from pathlib import Path
+
+from servostudio.od.library import EdsLibrary, builtin_library
+from servostudio.od.model import ObjectDictionary
+from servostudio.sim.bus import DEFAULT_BITRATE, Station, VirtualBus
+from servostudio.sim.clock import CONTROL_PERIOD, VirtualClock
+from servostudio.sim.events import DriveEvents
+from servostudio.sim.frame import Frame
+from servostudio.sim.node import Behaviour, SimulatedNode
+from servostudio.sim.objects import ObjectStore
+from servostudio.sim.sdo_server import DEFAULT_RESPONSE_TIME
+
+log = logging.getLogger(__name__)
+
+DEFAULT_DEVICE = "xtrapulspac"
+PACING_INTERVAL = 1e-3
+MAX_LAG = 0.05
+
+DeviceBehaviourFactory = Callable[[str, int, ObjectStore, DriveEvents], Behaviour]
+"""(device key, node ID, store, events) -> behaviour; the default builds servostudio.sim.drive behaviours."""
+
+
+@dataclass(frozen=True)
+class NodeSpec:
+    node_id: int
+    device: str
+
+
+def parse_node_list(text: str, default_device: str = DEFAULT_DEVICE) -> list[NodeSpec]:
+    """"1,2,3" or "1:xtrapulspac,2:xtrapulspac,3:cd1k" -> node specs (IDs 1..127, each once)."""
+    specs: list[NodeSpec] = []
+    for item in text.split(","):
+        item = item.strip()
+        if not item:
+            raise ValueError(f"node list {text!r}: empty entry")
+        number, _, device = item.partition(":")
+        try:
+            node_id = int(number, 0)
+        except ValueError:
+            raise ValueError(f"node list {text!r}: {number!r} is not a node ID") from None
+        if not 1 <= node_id <= 127:
+            raise ValueError(f"node list {text!r}: node ID {node_id} is outside 1..127")
+        if any(spec.node_id == node_id for spec in specs):
+            raise ValueError(f"node list {text!r}: node ID {node_id} appears twice")
+        specs.append(NodeSpec(node_id, device.strip().lower() or default_device))
+    return specs
+
+
+def drive_behaviour_factory(plant_file: Path | None = None, seed: int | None = None) -> DeviceBehaviourFactory:
+    """Behaviours from `servostudio.sim.drive`, each node with its own plant (docs/sim-plant.md).
+
+    The plant comes from `plant_file`, else is generated from `seed` + node ID (so drives differ); both give an
+    uncommissioned drive (factory values, to be commissioned). With neither, the commissioned default machine.
+    """
+    from servostudio.sim.drive import make_behaviour
+    from servostudio.sim.plant import Plant
+
+    commissioned = plant_file is None and seed is None
+
+    def factory(device: str, node_id: int, store: ObjectStore, events: DriveEvents) -> Behaviour:
+        if plant_file is not None:
+            plant = Plant.from_json(plant_file)
+        elif seed is not None:
+            plant = Plant.from_seed(seed + node_id)
+        else:
+            plant = Plant.commissioned()
+        return make_behaviour(device, store, plant, events, commissioned)
+
+    return factory
+
+
+class SimulatedNetwork:
+    def __init__(
+        self,
+        nodes: str | Iterable[NodeSpec | int],
+        *,
+        device: str = DEFAULT_DEVICE,
+        library: EdsLibrary | None = None,
+        dictionaries: dict[str, ObjectDictionary] | None = None,
+        behaviour_factory: DeviceBehaviourFactory | None = None,
+        bitrate: int | None = DEFAULT_BITRATE,
+        sdo_response_time: float = DEFAULT_RESPONSE_TIME,
+        state_dir: Path | None = None,
+    ) -> None:
+        specs = parse_node_list(nodes, device) if isinstance(nodes, str) else [
+            spec if isinstance(spec, NodeSpec) else NodeSpec(int(spec), device) for spec in nodes
+        ]
+        if not specs:
+            raise ValueError("a simulated network needs at least one node")
+        self.lock = threading.RLock()
+        self.clock = VirtualClock()
+        self.bus = VirtualBus(self.clock, bitrate)
+        factory = behaviour_factory or drive_behaviour_factory()
+        dictionaries = dict(dictionaries or {})
+        library = library or builtin_library()
+        self.nodes: dict[int, SimulatedNode] = {}
+        for spec in specs:
+            if spec.device not in dictionaries:
+                dictionaries[spec.device] = library.load(spec.device)
+            self.nodes[spec.node_id] = SimulatedNode(
+                spec.node_id,
+                dictionaries[spec.device],
+                self.clock,
+                self.bus,
+                lambda store, events, spec=spec: factory(spec.device, spec.node_id, store, events),
+                state_dir=state_dir,
+                sdo_response_time=sdo_response_time,
+            )
+        self._ticks = 0
+        self._node_list = list(self.nodes.values())
+        self.clock.call_at(CONTROL_PERIOD, self._tick)
+        self._thread: threading.Thread | None = None
+        self._stop = threading.Event()
+
+    # -- nodes ----------------------------------------------------------------------------------------------------
+
+    def node(self, node_id: int) -> SimulatedNode:
+        return self.nodes[node_id]
+
+    @property
+    def first_node(self) -> SimulatedNode:
+        return self._node_list[0]
+
+    # -- time -----------------------------------------------------------------------------------------------------
+
+    def _tick(self) -> None:
+        self._ticks += 1
+        self.clock.call_at((self._ticks + 1) * CONTROL_PERIOD, self._tick)  # first, so a failing step cannot stop time
+        for node in self._node_list:
+            node.step(CONTROL_PERIOD)
+
+    def advance(self, seconds: float) -> None:
+        """Run the simulation `seconds` of virtual time forward (deterministic; not while `start()`ed)."""
+        if self.running:
+            raise RuntimeError("advance() cannot step a network whose real-time thread is running")
+        with self.lock:
+            self.clock.run_until(self.clock.now + seconds)
+
+    @property
+    def now(self) -> float:
+        return self.clock.now
+
+    @property
+    def running(self) -> bool:
+        return self._thread is not None and self._thread.is_alive()
+
+    def start(self) -> None:
+        """Run in real time on a background (daemon) thread until `stop()`."""
+        if self.running:
+            return
+        self._stop.clear()
+        self._thread = threading.Thread(target=self._run, name="sim-clock", daemon=True)
+        self._thread.start()
+
+    def stop(self) -> None:
+        self._stop.set()
+        if self._thread is not None:
+            self._thread.join()
+            self._thread = None
+
+    def _run(self) -> None:
+        origin_wall = time.monotonic()
+        origin_virtual = self.clock.now
+        while not self._stop.wait(PACING_INTERVAL):
+            target = origin_virtual + (time.monotonic() - origin_wall)
+            with self.lock:
+                try:
+                    self.clock.run_until(min(target, self.clock.now + MAX_LAG))
+                except Exception:  # keep serving the other drives and clients; the failed event is dropped
+                    log.exception("simulation event failed at t=%.6f s", self.clock.now)
+                behind = target - self.clock.now
+            if behind > MAX_LAG:
+                origin_wall += behind  # slip: the host is too slow, virtual time runs slower than real time
+
+    def __enter__(self) -> "SimulatedNetwork":
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.stop()
+
+    # -- frames from outside --------------------------------------------------------------------------------------
+
+    def attach(self, station: Station) -> None:
+        with self.lock:
+            self.bus.attach(station)
+
+    def detach(self, station: Station) -> None:
+        with self.lock:
+            self.bus.detach(station)
+
+    def inject(self, frame: Frame, sender: Station | None = None) -> None:
+        """Put a frame from outside (client, socketcand, serial) on the bus at the current virtual time."""
+        with self.lock:
+            self.bus.transmit(frame, sender)
+
+    def open_bus(self, channel: str = "sim", **kwargs: object):
+        """A python-can bus attached to this network (e.g. `canopen.Network(network.open_bus())`)."""
+        from servostudio.sim.inprocess import SimulatedCanBus
+
+        return SimulatedCanBus(self, channel=channel, **kwargs)

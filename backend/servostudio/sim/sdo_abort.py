@@ -1,0 +1,39 @@
+"""SDO abort codes (CiA 301 §7.2.4.3.17) and the exception that carries one out of the object store."""
+
+from __future__ import annotations
+
+TOGGLE_BIT_NOT_ALTERNATED = 0x05030000
+SDO_TIMEOUT = 0x05040000
+INVALID_COMMAND = 0x05040001
+INVALID_BLOCK_SIZE = 0x05040002
+INVALID_SEQUENCE_NUMBER = 0x05040003
+CRC_ERROR = 0x05040004
+OUT_OF_MEMORY = 0x05040005
+UNSUPPORTED_ACCESS = 0x06010000
+WRITE_ONLY = 0x06010001
+READ_ONLY = 0x06010002
+OBJECT_DOES_NOT_EXIST = 0x06020000
+CANNOT_BE_MAPPED = 0x06040041
+PDO_LENGTH_EXCEEDED = 0x06040042
+PARAMETER_INCOMPATIBLE = 0x06040043
+HARDWARE_ERROR = 0x06060000
+LENGTH_MISMATCH = 0x06070010
+LENGTH_TOO_HIGH = 0x06070012
+LENGTH_TOO_LOW = 0x06070013
+SUBINDEX_DOES_NOT_EXIST = 0x06090011
+INVALID_VALUE = 0x06090030
+VALUE_TOO_HIGH = 0x06090031
+VALUE_TOO_LOW = 0x06090032
+GENERAL = 0x08000000
+CANNOT_TRANSFER = 0x08000020
+CANNOT_TRANSFER_LOCAL = 0x08000021
+CANNOT_TRANSFER_STATE = 0x08000022
+
+
+class SdoAbort(Exception):
+    """Refusal of an object access; the SDO server answers with `code`, an RPDO write is dropped."""
+
+    def __init__(self, code: int, reason: str = "") -> None:
+        self.code = code
+        self.reason = reason
+        super().__init__(f"SDO abort 0x{code:08X}" + (f": {reason}" if reason else ""))

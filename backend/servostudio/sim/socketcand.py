@@ -1,0 +1,203 @@
+"""TCP server speaking the socketcand protocol (raw mode), as python-can's `socketcand` interface uses it.
+
+Session: server `< hi >`; client `< open CHANNEL >` → `< ok >` (or `< error … >` for another channel name);
+client `< rawmode >` → `< ok >`; then the client sends `< send ID LEN B0 B1 … >` (hex, an 8-digit ID is extended)
+and receives every bus frame as `< frame ID SECONDS.MICROSECONDS HEXDATA >` with the virtual time stamp. Each
+connection is a station on the virtual bus (it does not receive its own frames, it does see other clients').
+
+python-can reads each handshake answer with a single `recv`, so bus frames start flowing `SETTLE_TIME` after the
+`< ok >` of raw mode (frames of that interval are queued, not lost).
+"""
+
+from __future__ import annotations
+
+import logging
+import queue
+import socket
+import threading
+import time
+
+from servostudio.sim.frame import Frame
+from servostudio.sim.network import SimulatedNetwork
+
+log = logging.getLogger(__name__)
+
+DEFAULT_PORT = 29536
+DEFAULT_CHANNEL = "can0"
+SETTLE_TIME = 0.1
+OUTPUT_QUEUE_LIMIT = 100_000  # frames waiting for a client that does not read; beyond it they are dropped
+_MAX_COMMAND = 256
+
+
+def format_frame(frame: Frame, timestamp: float) -> str:
+    can_id = f"{frame.can_id:08X}" if frame.extended else f"{frame.can_id:03X}"
+    return f"< frame {can_id} {timestamp:.6f} {frame.data.hex().upper()} >"
+
+
+def parse_send(arguments: list[str]) -> Frame:
+    """`["601", "8", "40", "18", ...]` -> Frame; ValueError with the reason when malformed."""
+    if len(arguments) < 2:
+        raise ValueError("send needs an identifier and a length")
+    can_id, length = int(arguments[0], 16), int(arguments[1], 16)
+    data = bytes(int(byte, 16) for byte in arguments[2:])
+    if length != len(data):
+        raise ValueError(f"length {length} but {len(data)} data bytes")
+    return Frame(can_id, data, extended=len(arguments[0]) == 8)
+
+
+class SocketcandServer:
+    def __init__(self, network: SimulatedNetwork, host: str = "127.0.0.1", port: int = DEFAULT_PORT,
+                 channel: str = DEFAULT_CHANNEL) -> None:
+        self.network = network
+        self.channel = channel
+        self._listener = socket.create_server((host, port), reuse_port=False)
+        self._listener.settimeout(0.2)
+        self._sessions: list[_Session] = []
+        self._stop = threading.Event()
+        self._thread = threading.Thread(target=self._accept_loop, name="socketcand", daemon=True)
+
+    @property
+    def address(self) -> tuple[str, int]:
+        host, port = self._listener.getsockname()[:2]
+        return host, port
+
+    def start(self) -> "SocketcandServer":
+        self._thread.start()
+        return self
+
+    def stop(self) -> None:
+        self._stop.set()
+        if self._thread.is_alive():
+            self._thread.join()
+        self._listener.close()
+        for session in list(self._sessions):
+            session.close()
+
+    def __enter__(self) -> "SocketcandServer":
+        return self.start()
+
+    def __exit__(self, *exc: object) -> None:
+        self.stop()
+
+    def _accept_loop(self) -> None:
+        while not self._stop.is_set():
+            try:
+                connection, peer = self._listener.accept()
+            except TimeoutError:
+                continue
+            except OSError:
+                return
+            log.info("socketcand client %s connected", peer)
+            session = _Session(self, connection)
+            self._sessions.append(session)
+            session.start()
+
+    def _forget(self, session: "_Session") -> None:
+        if session in self._sessions:
+            self._sessions.remove(session)
+
+
+class _Session:
+    """One client connection: a reader thread parsing commands, a writer thread draining the output queue."""
+
+    def __init__(self, server: SocketcandServer, connection: socket.socket) -> None:
+        self.server = server
+        self.connection = connection
+        connection.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
+        self._output: queue.SimpleQueue[str | float | None] = queue.SimpleQueue()
+        self._opened = False
+        self._attached = False
+        self._closed = threading.Event()
+
+    def start(self) -> None:
+        threading.Thread(target=self._write_loop, name="socketcand-tx", daemon=True).start()
+        threading.Thread(target=self._read_loop, name="socketcand-rx", daemon=True).start()
+        self._output.put("< hi >")
+
+    def close(self) -> None:
+        if self._closed.is_set():
+            return
+        self._closed.set()
+        if self._attached:
+            self.server.network.detach(self)
+        self._output.put(None)
+        try:
+            self.connection.shutdown(socket.SHUT_RDWR)
+        except OSError:
+            pass
+        self.connection.close()
+        self.server._forget(self)
+
+    # -- station --------------------------------------------------------------------------------------------------
+
+    def receive(self, frame: Frame, timestamp: float) -> None:
+        if self._output.qsize() < OUTPUT_QUEUE_LIMIT:
+            self._output.put(format_frame(frame, timestamp))
+
+    # -- threads --------------------------------------------------------------------------------------------------
+
+    def _write_loop(self) -> None:
+        while True:
+            item = self._output.get()
+            if item is None:
+                return
+            if isinstance(item, float):
+                time.sleep(item)
+                continue
+            try:
+                self.connection.sendall(item.encode("ascii"))
+            except OSError:
+                self.close()
+                return
+
+    def _read_loop(self) -> None:
+        buffer = ""
+        while not self._closed.is_set():
+            try:
+                chunk = self.connection.recv(4096)
+            except OSError:
+                break
+            if not chunk:
+                break
+            buffer += chunk.decode("ascii", errors="replace")
+            buffer = self._consume(buffer)
+        self.close()
+
+    def _consume(self, buffer: str) -> str:
+        while True:
+            start = buffer.find("<")
+            if start == -1:
+                return ""
+            end = buffer.find(">", start)
+            if end == -1:
+                return buffer[start:] if len(buffer) - start <= _MAX_COMMAND else ""
+            self._command(buffer[start + 1 : end].split())
+            buffer = buffer[end + 1 :]
+
+    def _command(self, words: list[str]) -> None:
+        if not words:
+            return
+        verb, arguments = words[0], words[1:]
+        if verb == "open":
+            if arguments != [self.server.channel]:
+                self._output.put(f"< error could not open bus '{' '.join(arguments)}' >")
+                return
+            self._opened = True
+            self._output.put("< ok >")
+        elif verb == "rawmode" and self._opened:
+            self._output.put("< ok >")
+            self._output.put(SETTLE_TIME)
+            if not self._attached:
+                self._attached = True
+                self.server.network.attach(self)
+        elif verb == "send" and self._attached:
+            try:
+                frame = parse_send(arguments)
+            except ValueError as exc:
+                self._output.put(f"< error {exc} >")
+                return
+            self.server.network.inject(frame, sender=self)
+        elif verb == "echo":
+            self._output.put("< echo >")
+        else:
+            self._output.put(f"< error unsupported command '{verb}' >")

@@ -1,0 +1,1 @@
+"""transport layer (see servostudio/__init__.py)."""

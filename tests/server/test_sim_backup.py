@@ -1,0 +1,128 @@
+"""Backup and restore against the simulated drives over socketcand and over the RS-232 link, including a link cut and its recovery."""
+
+from __future__ import annotations
+
+import time
+
+import pytest
+
+from servostudio.services.backup import (
+    BackupError,
+    FileKind,
+    RestoreValidationError,
+    backup_file,
+    restore_file,
+)
+from servostudio.formats.objectfile import read_object_file
+from servostudio.services.bus import ConnectionManager
+from servostudio.services.scan import scan
+
+
+@pytest.fixture(scope="module")
+def connection(endpoint, commission):
+    manager = ConnectionManager()
+    bus = manager.open(endpoint.spec)
+    assert bus.link.connected
+    scan(bus)
+    for node in bus.nodes:
+        commission(bus.drive(node))  # once per transport: the drives keep their values between modules
+    yield bus
+    manager.close_all()
+
+
+def _cut_at(endpoint, fraction):
+    """A progress callback that cuts the link once ``fraction`` of the work is done."""
+    def progress(event):
+        if event["done"] >= fraction * event["total"] and endpoint.server is not None:
+            endpoint.cut()
+    return progress
+
+
+def _values(path):
+    return {(entry.index, entry.sub): entry.value for entry in read_object_file(path)}
+
+
+def test_backup_change_restore_read_back(connection, tmp_path):
+    drive = connection.drive(1)
+    original = tmp_path / "DRIVEPAR.TXT"
+    result = backup_file(drive, original)
+    assert result.objects > 300 and result.kind == "DRIVEPAR.TXT"
+    saved = _values(original)
+    kpv = drive.variable("0x60F9,2")
+    assert saved[(0x60F9, 2)] == drive.read(kpv).raw
+
+    changed_value = kpv.minimum if saved[(0x60F9, 2)] != kpv.minimum else kpv.maximum
+    drive.write(kpv, changed_value)
+    assert drive.read(kpv).raw == changed_value
+
+    restored = restore_file(drive, original)
+    assert restored.ok, restored.as_dict()
+    assert restored.stored == "save"
+    assert drive.read(kpv).raw == saved[(0x60F9, 2)]
+    again = tmp_path / "again" / "DRIVEPAR.TXT"
+    again.parent.mkdir()
+    backup_file(drive, again)
+    assert _values(again) == saved
+
+
+def test_user_par_backup_contains_only_user_objects(connection, tmp_path):
+    drive = connection.drive(2)
+    path = tmp_path / "USER_PAR.TXT"
+    result = backup_file(drive, path)
+    assert result.kind == "USER_PAR.TXT"
+    keys = _values(path)
+    assert keys and all(drive.dictionary[key].save_type.value == "USER_PAR" for key in keys)
+
+
+def test_corrupted_file_is_refused_with_its_line_and_nothing_is_written(connection, tmp_path, sim_network):
+    drive = connection.drive(3)
+    path = tmp_path / "DRIVEPAR.TXT"
+    backup_file(drive, path)
+    lines = path.read_text(encoding="latin-1").splitlines()
+    kpv_line = next(number for number, line in enumerate(lines, 1) if line.startswith("0x60F9,2="))
+    lines[kpv_line - 1] = "0x60F9,2=banana"
+    pole_line = next(number for number, line in enumerate(lines, 1) if line.startswith("0x3410,1="))
+    lines[pole_line - 1] = "0x3410,1=99"
+    path.write_text("\n".join(lines) + "\n", encoding="latin-1")
+    first_bad = min(kpv_line, pole_line)
+
+    frames = []
+    station = type("Spy", (), {"receive": lambda self, frame, timestamp: frames.append(frame)})()
+    sim_network.attach(station)
+    try:
+        with pytest.raises(RestoreValidationError) as error:
+            restore_file(drive, path)
+    finally:
+        sim_network.detach(station)
+    assert f"DRIVEPAR.TXT:{first_bad}:" in str(error.value)
+    assert "nothing was written to node 3" in str(error.value)
+    assert not any(0x601 <= frame.can_id <= 0x67F and frame.data[0] & 0xE0 == 0x20 for frame in frames)
+
+
+def test_link_cut_during_backup_leaves_no_file_and_link_recovers(connection, endpoint, tmp_path):
+    drive = connection.drive(1)
+    path = tmp_path / "DRIVEPAR.TXT"
+    with pytest.raises(BackupError, match="no file written"):
+        backup_file(drive, path, progress=_cut_at(endpoint, 0.3))
+    assert not path.exists()
+    assert list(tmp_path.iterdir()) == []  # no temporary file left either
+    endpoint.restore()
+    assert connection.link.wait_connected(5.0)
+    assert backup_file(drive, path).objects > 300
+
+
+def test_link_cut_during_restore_says_what_was_written(connection, endpoint, tmp_path):
+    drive = connection.drive(2)
+    path = tmp_path / "DRIVEPAR.TXT"
+    backup_file(drive, path)
+    result = restore_file(drive, path, progress=_cut_at(endpoint, 0.3))
+    assert not result.ok
+    assert "objects had been written; nothing was stored to flash" in result.error
+    assert result.stored == ""
+    endpoint.restore()
+    assert connection.link.wait_connected(5.0)
+    deadline = time.monotonic() + 5
+    while not connection.link.connected and time.monotonic() < deadline:
+        time.sleep(0.05)
+    rerun = restore_file(drive, path)  # a failed restore can simply be run again
+    assert rerun.ok, rerun.as_dict()
