@@ -11,6 +11,7 @@ WORKDIR /app
 COPY pyproject.toml README.md ./
 COPY backend/ backend/
 COPY eds/ eds/
+COPY motors/ motors/
 COPY --from=frontend /src/backend/servostudio/static/ backend/servostudio/static/
 RUN pip install --no-cache-dir -e .
 COPY projects/ /app/projects/

@@ -24,7 +24,9 @@ CHROMIUM_ARGS = [
 ]
 
 
-@pytest.fixture(scope="session")
+# Package scope: Playwright's sync API keeps an event loop running while the browser is open, which would
+# break asyncio.run() in the tests collected after this package.
+@pytest.fixture(scope="package")
 def browser() -> Browser:
     executable = shutil.which("chromium")
     if executable is None:
