@@ -29,6 +29,7 @@ EXPECTED_REFERENCE = {
     33: -0.7, 34: 0.3, 35: 0.0,
     -1: -1.7, -2: 2.3, -3: -2.5, -4: 2.5,
 }
+INDEX_METHODS = frozenset(range(1, 15)) | {33, 34, -1, -2}
 EDGE_TOLERANCE = 8  # one control period at the slow speed plus quantisation
 INDEX_TOLERANCE = 2
 
@@ -53,10 +54,7 @@ def test_homing_method_finds_its_reference(harness, method):
     assert h.status & 0x3400 == 0x1400, f"homing error, status {h.status:#06x}"
     turns_now = h.drive.physics.load_turns
     expected = HOME_OFFSET + (turns_now - EXPECTED_REFERENCE[method]) * REV
-    tolerance = INDEX_TOLERANCE if method in (1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 33, 34, -1, -2) \
-        else EDGE_TOLERANCE
-    if method in (-3, -4, 35):
-        tolerance = EDGE_TOLERANCE
+    tolerance = INDEX_TOLERANCE if method in INDEX_METHODS else EDGE_TOLERANCE
     assert h.read(0x6064) == pytest.approx(expected, abs=tolerance)
     assert h.read(0x3218) == 1
     if method != 35:

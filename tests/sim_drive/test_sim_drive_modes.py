@@ -161,3 +161,45 @@ def test_limit_switch_stops_pv_motion_towards_it_and_sets_the_warning(harness):
     h.run_until(lambda: not h.read(0x60FD) & 0x2, 2.0)
     h.run(0.01)
     assert not h.read(0x3024) & (1 << 16)
+
+
+def max_jerk_of_move(h, profile_type: int) -> float:
+    h.write(0x6086, 0, profile_type)
+    pp_ready(h)
+    start = h.read(0x6064)
+    new_set_point(h, start + REV * 3)
+    loops = h.drive.loops
+    previous, jerk = loops.accel_ff, 0.0
+    for _ in range(2000):
+        h.run(0.00025)
+        jerk = max(jerk, abs(loops.accel_ff - previous))
+        previous = loops.accel_ff
+        if h.status & TARGET_REACHED:
+            break
+    assert h.status & TARGET_REACHED
+    assert abs(h.read(0x6064) - (start + REV * 3)) <= 20
+    return jerk
+
+
+def test_pp_s_curve_reaches_the_same_target_with_limited_jerk(harness):
+    trapezoid = max_jerk_of_move(harness(), 0)
+    s_curve = max_jerk_of_move(harness(), -1)
+    assert s_curve < trapezoid / 20
+
+
+def test_ip_missing_set_point_is_error_50(harness):
+    h = harness()
+    h.write(0x1006, 0, 2000)
+    h.enable(7)
+    h.control(0x1F)
+    target = h.read(0x6064)
+    for _ in range(10):
+        h.write(0x60C1, 1, target)
+        h.drive.on_sync()
+        h.run(0.002)
+    assert h.status & 0x0F != 0x08
+    h.drive.on_sync()  # no set-point this cycle
+    h.run(0.002)
+    assert h.status & 0x0F == 0x08
+    assert h.read(0x3022, 2) == 1 << 17  # code 50
+    assert h.events.emergencies[-1][:2] == (0x8782, 50)

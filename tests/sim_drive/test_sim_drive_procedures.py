@@ -201,3 +201,18 @@ def test_auto_tuning_in_profile_velocity_leaves_position_gains_zero(harness):
     assert h.read(0x3426) == 5
     assert h.read(0x60FB, 2) == 0
     assert h.read(0x60FB, 3) == 0
+
+
+def test_commissioned_encoder_axis_still_needs_motor_phasing_after_power_up(harness):
+    plant = replace(Plant.commissioned(), feedback=FEEDBACK_ENCODER, encoder_counts=8192, initial_position=0.37)
+    h = harness(plant=plant)
+    h.run(0.01)
+    assert h.read(0x3024) & (1 << 30)
+    h.write(0x3414, 0, MCAL)
+    h.run_until(lambda: h.read(0x3414) != 2, 10.0, step=0.05)
+    assert h.read(0x3414) == 5
+    h.enable(3)
+    h.write(0x6083, 0, 4096 * 50)
+    h.write(0x60FF, 0, 4096 * 2)
+    h.run(0.3)
+    assert h.read(0x606C) == pytest.approx(4096 * 2, rel=0.05)

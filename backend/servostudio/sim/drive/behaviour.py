@@ -51,7 +51,7 @@ from servostudio.sim.drive.statemachine import (
 )
 from servostudio.sim.drive.runner import ProcedureRunner
 from servostudio.sim.drive.units import RPM, UnitScaling
-from servostudio.sim.objects import ObjectStore
+from servostudio.sim.objects import ObjectStore, zero_value
 from servostudio.sim.plant import FEEDBACK_ENCODER, PHASE_240, Plant
 
 REMOTE = 1 << 9
@@ -108,7 +108,7 @@ class DriveBehaviour:
         self.inhibit_active = False
         self.negative_limit = self.positive_limit = self.home_switch = False
         self.position_offset_user = 0.0
-        self.phasing_valid = not (plant.feedback == FEEDBACK_ENCODER and not commissioned)
+        self.phasing_valid = plant.feedback != FEEDBACK_ENCODER  # an incremental encoder needs 'mcal' first
         self.max_speed = 1.0
         self.rated_current = 1.0
         self.max_current = 1.0
@@ -132,6 +132,8 @@ class DriveBehaviour:
         self._published_inputs = -1
         self._current_filter = 0.0
         self._current_filter_alpha = 1.0
+        self._velocity_filter = 0.0
+        self._velocity_filter_alpha = 1.0
         if commissioned:
             self.apply_commissioning()
         self._register_hooks()
@@ -254,9 +256,11 @@ class DriveBehaviour:
             if address is None:
                 continue
             variable = self.store.od[address]
-            if self.store.get(*address) == variable.default_for(self.store.node_id) or variable.default is None:
+            factory = variable.default_for(self.store.node_id)
+            if factory is None:
+                factory = zero_value(variable.data_type)
+            if self.store.get(*address) == factory:
                 self.store.set(address[0], address[1], self._fit(variable, value))
-        self.phasing_valid = True
 
     @staticmethod
     def _fit(variable: Any, value: int) -> int:
@@ -308,8 +312,11 @@ class DriveBehaviour:
         )
         loops.torque_offset = float(read("torque_offset", 0)) / 1000.0 * self.rated_current
         loops.torque_offset_2 = float(read("torque_offset_2", 0)) / 1000.0 * self.rated_current
-        filter_hz = 1000.0
-        self._current_filter_alpha = low_pass_alpha(filter_hz, dt * SUPERVISION_PERIODS)
+        supervision_dt = dt * SUPERVISION_PERIODS
+        self._current_filter_alpha = low_pass_alpha(max(float(read("current_monitor_filter", 1000)), 1.0),
+                                                    supervision_dt)
+        velocity_hz = float(read("velocity_monitor_filter", 0)) * 0.1
+        self._velocity_filter_alpha = low_pass_alpha(velocity_hz, supervision_dt) if velocity_hz > 0 else 1.0
         options = self._stop_options
         options.quick_stop = int(read("quick_stop_code", 1))
         options.shutdown = int(read("shutdown_code", 0))
@@ -549,11 +556,19 @@ class DriveBehaviour:
         if self.i2t.limiting:
             limit = min(limit, self.rated_current)
         if self.device_control.stop_type == STOP_CURRENT_LIMIT:
-            limit = min(limit, float(self.p.get("stop_current_limit", 1000)) / 1000.0 * self.rated_current)
+            limit = min(limit, self.stop_current())
         homing = self._active_handler
         if isinstance(homing, HomingMode) and homing.uses_current_limit:
-            limit = min(limit, float(self.p.get("homing_current_limit", 0x400)) / 0x3FFF * self.drive_max_current)
+            limit = min(limit, self.homing_current())
         return limit
+
+    def stop_current(self) -> float:
+        """Stop 3 current limit: 0x3301,1 in ‰ of the rated current 0x6075."""
+        return float(self.p.get("stop_current_limit", 1000)) / 1000.0 * self.rated_current
+
+    def homing_current(self) -> float:
+        """Mechanical-stop homing limit: 0x309C with 0x3FFF = the drive max current 0x6510,1."""
+        return float(self.p.get("homing_current_limit", 0x400)) / 0x3FFF * self.drive_max_current
 
     def brake_engaged(self) -> bool:
         if not self.plant.has_brake:
@@ -745,8 +760,10 @@ class DriveBehaviour:
     # -- publishing ---------------------------------------------------------------------------------------------
 
     def _publish_fast(self) -> None:
-        """Every period: the status word (its changes trigger event TPDOs) and the current-monitor filter."""
-        self._current_filter += self._current_filter_alpha * (self.loops.i_q - self._current_filter)
+        """Every 1 ms and on state changes: monitor filters (0x3078, 0x306C) and the status word (event TPDOs)."""
+        loops = self.loops
+        self._current_filter += self._current_filter_alpha * (loops.i_q - self._current_filter)
+        self._velocity_filter += self._velocity_filter_alpha * (loops.speed - self._velocity_filter)
         self._published_state = self.device_control.state
         status = self.status_word()
         if status != self._published_status:
@@ -762,7 +779,7 @@ class DriveBehaviour:
         demand = loops.position_ref if loops.mode == MODE_POSITION else position
         return {
             "position_actual": _wrap_i32(units.to_user(position) + offset),
-            "velocity_actual": _wrap_i32(units.speed_to_user(loops.speed)),
+            "velocity_actual": _wrap_i32(units.speed_to_user(self._velocity_filter)),
             "position_demand": _wrap_i32(units.to_user(demand) + offset),
             "following_error_actual": _wrap_i32(units.to_user(demand - position)),
             "current_actual": _clamp_i16(1000.0 * self._current_filter / self.rated_current),

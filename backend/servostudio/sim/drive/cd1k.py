@@ -7,6 +7,7 @@ Differences from the XtrapulsPac that the simulation reproduces:
   auto-tuning 'atun' on 0x3420,2 with bandwidth 0x3420,1;
 - the gain records have other sub-indices (0x60F6,1..4 q/d, 0x60F9,1 KP … 0x60FB,1 KPp …);
 - errors in the 0x3020 bit field (EMCY bytes 3–6), fault reactions by the masks 0x3330 (Stop 1) / 0x3331 (Stop 3);
+- stop current 0x3301 and homing current 0x309C with 0x3FFF = 100 % (of the rating / of the max current);
 - no halt bit; default mode ip (7).
 The scalings of the gains are the project's (docs/control-loops.md), as for the XtrapulsPac.
 """
@@ -55,7 +56,6 @@ CD1K = DeviceProfile(
         "homing_current_limit": (0x309C, 0),
         "dynamic_current_limit": (0x30D1, 0),
         "current_monitor": (0x30D4, 0),
-        "homing_indicator": (0x3217, 0),
         "slow_down_ramp": (0x3300, 1),
         "stop_current_limit": (0x3301, 0),
         "drive_reaction_time": (0x3304, 0),
@@ -100,6 +100,14 @@ class Cd1kBehaviour(DriveBehaviour):
         maximum = float(self.p.get("max_current_share", FULL_SCALE)) / FULL_SCALE * rating or rating
         rated = float(self.p.get("rated_current_share", FULL_SCALE // 2)) / FULL_SCALE * rating or rating / 2
         return rating, rated, maximum
+
+    def stop_current(self) -> float:
+        """0x3301: 0x3FFF = 100 % of the drive rating."""
+        return float(self.p.get("stop_current_limit", FULL_SCALE)) / FULL_SCALE * self.drive_max_current
+
+    def homing_current(self) -> float:
+        """0x309C: 0x3FFF = 100 % of the max current 0x6510,5."""
+        return float(self.p.get("homing_current_limit", 0x400)) / FULL_SCALE * self.max_current
 
     def phase_sign_of(self, value: int) -> int:
         return -1 if value == 1 else 1

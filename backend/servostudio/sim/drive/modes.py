@@ -9,9 +9,10 @@ from __future__ import annotations
 import math
 from typing import TYPE_CHECKING
 
+from servostudio.sim.drive import errors
 from servostudio.sim.drive.homing import FAST, Homing, HomingInputs, HomingStatus
 from servostudio.sim.drive.loops import MODE_POSITION, MODE_TORQUE, MODE_VELOCITY
-from servostudio.sim.drive.profiles import PositionProfile, VelocityRamp
+from servostudio.sim.drive.profiles import PositionProfile, SmoothedProfile, VelocityRamp
 
 if TYPE_CHECKING:
     from servostudio.sim.drive.behaviour import DriveBehaviour
@@ -52,7 +53,7 @@ class ProfilePosition(ModeHandler):
 
     def __init__(self, drive: DriveBehaviour) -> None:
         super().__init__(drive)
-        self.generator = PositionProfile(drive.dt)
+        self.generator = SmoothedProfile(drive.dt)
         self.target_user = 0.0
         self.acknowledged = False
         self.queued: tuple[float, float, float, float] | None = None
@@ -100,7 +101,11 @@ class ProfilePosition(ModeHandler):
         target_user, speed, accel, decel = set_point
         self.target_user = target_user
         drive = self.drive
-        self.generator.move_to(drive.user_to_rad_position(target_user), speed, accel, decel)
+        window = 1
+        if int(drive.p.get("motion_profile_type", 0)) == -1:
+            # S-curve: smooth over the time the trapezoid needs to reach its speed (at most 0.2 s)
+            window = max(1, round(min(speed / max(accel, 1e-9), 0.2) / drive.dt))
+        self.generator.move_to(drive.user_to_rad_position(target_user), speed, accel, decel, window)
         self.reached = False
         self.in_window_time = 0.0
 
@@ -399,6 +404,11 @@ class InterpolatedPosition(ModeHandler):
         self.next = 0.0
         self.elapsed = 0.0
         self.period = 0.01
+        self.fresh = False
+        self.synced = 0
+        address = drive.profile.address("ip_data")
+        if address is not None and address in drive.store:
+            drive.store.on_write(address[0], address[1], self.set_point_written)
 
     def enter(self) -> None:
         position = self.drive.loops.position
@@ -410,10 +420,21 @@ class InterpolatedPosition(ModeHandler):
         drive = self.drive
         return bool(drive.control_word & CW_NEW_SET_POINT) and drive.device_control.follows_set_points
 
+    def set_point_written(self, index: int, sub: int, value: object) -> None:
+        """Write hook of 0x60C1,1 (SDO or RPDO): a set-point arrived for the next SYNC."""
+        self.fresh = True
+
     def sync(self) -> None:
+        """SYNC: take the new set-point; error 50 when none arrived during the last cycle (manual L3805)."""
         drive = self.drive
         if not self.active:
+            self.synced = 0
             return
+        if not self.fresh and self.synced:
+            drive.raise_error(errors.IP_UNDERFLOW)
+            return
+        self.fresh = False
+        self.synced += 1
         current = self.previous + (self.next - self.previous) * min(1.0, self.elapsed / self.period)
         self.previous = current
         self.next = drive.user_to_rad_position(float(drive.live("ip_data", 0)))

@@ -95,3 +95,70 @@ class VelocityRamp:
         self.acceleration = (new_v - v) / self.dt
         self.velocity = new_v
         return new_v
+
+
+class SmoothedProfile:
+    """A `PositionProfile` followed by a moving average over `window` periods (0x6086 = −1, S-curve).
+
+    Averaging the trapezoid's positions over a time T turns each acceleration step into a linear ramp lasting T
+    (limited jerk) and keeps the end position exactly; a window of 1 is the plain trapezoid.
+    """
+
+    def __init__(self, dt: float) -> None:
+        self.dt = dt
+        self.trapezoid = PositionProfile(dt)
+        self.window = 1
+        self.position = 0.0
+        self.velocity = 0.0
+        self.acceleration = 0.0
+        self._samples: list[float] = [0.0]
+        self._next = 0
+        self._sum = 0.0
+
+    @property
+    def done(self) -> bool:
+        return self.trapezoid.done and self.position == self.trapezoid.target
+
+    @property
+    def target(self) -> float:
+        return self.trapezoid.target
+
+    def reset(self, position: float) -> None:
+        self.trapezoid.reset(position)
+        self._fill(position)
+
+    def move_to(self, target: float, max_velocity: float, accel: float, decel: float, window: int = 1) -> None:
+        """Start a move; the smoothing window can only change when the profile is at rest."""
+        if self.done and window != self.window:
+            self.window = max(1, window)
+            self._fill(self.position)
+        self.trapezoid.move_to(target, max_velocity, accel, decel)
+
+    def _fill(self, position: float) -> None:
+        self._samples = [position] * self.window
+        self._sum = position * self.window
+        self._next = 0
+        self.position = position
+        self.velocity = 0.0
+        self.acceleration = 0.0
+
+    def step(self) -> None:
+        trapezoid = self.trapezoid
+        trapezoid.step()
+        if self.window == 1:
+            self.position = trapezoid.position
+            self.velocity = trapezoid.velocity
+            self.acceleration = trapezoid.acceleration
+            return
+        new = trapezoid.position
+        self._sum += new - self._samples[self._next]
+        self._samples[self._next] = new
+        self._next = (self._next + 1) % self.window
+        position = self._sum / self.window
+        if trapezoid.done and all(sample == new for sample in self._samples):
+            position = new
+            self._sum = new * self.window
+        velocity = (position - self.position) / self.dt
+        self.acceleration = (velocity - self.velocity) / self.dt
+        self.velocity = velocity
+        self.position = position
