@@ -88,12 +88,14 @@ def round_trip_bound(node: int, index: int, sub: int, data: bytes) -> tuple[floa
         command = 0x43 | (4 - len(data)) << 2
         pairs = [(request, Frame(0x580 + node, bytes([command, index & 0xFF, index >> 8, sub]) + data.ljust(4, b"\0")))]
     else:
-        pairs = [(request, Frame(0x580 + node, bytes([0x41, index & 0xFF, index >> 8, sub]) + len(data).to_bytes(4, "little")))]
+        initiate = bytes([0x41, index & 0xFF, index >> 8, sub]) + len(data).to_bytes(4, "little")
+        pairs = [(request, Frame(0x580 + node, initiate))]
         for segment in range(math.ceil(len(data) / 7)):
             chunk = data[segment * 7 : segment * 7 + 7]
             last = segment == math.ceil(len(data) / 7) - 1
-            pairs.append((Frame(0x600 + node, bytes([0x60 | (segment & 1) << 4]) + bytes(7)),
-                          Frame(0x580 + node, bytes([(segment & 1) << 4 | (7 - len(chunk)) << 1 | last]) + chunk.ljust(7, b"\0"))))
+            answer = bytes([(segment & 1) << 4 | (7 - len(chunk)) << 1 | last]) + chunk.ljust(7, b"\0")
+            ask = bytes([0x60 | (segment & 1) << 4]) + bytes(7)
+            pairs.append((Frame(0x600 + node, ask), Frame(0x580 + node, answer)))
     bus = sum(frame_duration(a, BITRATE) + frame_duration(b, BITRATE) for a, b in pairs)
     return bus + len(pairs) * DEFAULT_RESPONSE_TIME, bus
 
@@ -235,7 +237,8 @@ def main() -> int:
                 result = measure_backup(bench, chosen, Path(folder))
                 print(f"| {label} | {result['objects']} | {result['bound']:.3f} | {result['wall']:.3f} | "
                       f"{result['wall'] / result['bound']:.2f} | {result['naive_wall']:.3f} | "
-                      f"{result['naive_wall'] / result['wall']:.1f} | {result['cpu_us']:.0f} / {result['naive_cpu_us']:.0f} |")
+                      f"{result['naive_wall'] / result['wall']:.1f} | "
+                      f"{result['cpu_us']:.0f} / {result['naive_cpu_us']:.0f} |")
     finally:
         bench.close()
     return 0

@@ -125,10 +125,13 @@ def test_compare_takes_a_drive_column(axis: ProjectService):
 
     axis.parameters.set("p", "X", {"0x3051": 1, "0x3055": 2})
     rows, _ = axis.parameters.compare("p", "X", only_differences=True, drive=Drive())
+    # against a drive only drive != project counts: 0x3051 matches the project although both differ from default
     assert [(row.variable.index, row.values) for row in rows] == [
-        (0x3051, {"drive": 1, "project": 1, "default": 0}),
         (0x3055, {"drive": 0, "project": 2, "default": 0}),
     ]
+    all_rows, _ = axis.parameters.compare("p", "X", drive=Drive())
+    same = next(row for row in all_rows if row.variable.key == (0x3051, 0))
+    assert (same.values, same.differs) == ({"drive": 1, "project": 1, "default": 0}, False)
 
 
 def _real(data_type: DataType) -> Variable:

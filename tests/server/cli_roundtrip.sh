@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# CLI round trip against a running bus: backup, change, restore, read back; refusals and their exit codes.
+# CLI round trip against a running bus: backup, change, restore, read back; a corrupted file refused.
+# (The other exit codes are checked in-process by test_cli_commands.py: each launch here costs a second.)
 # usage: cli_roundtrip.sh BUS_SPEC WORK_DIR   (SERVOSTUDIO may name the servostudio executable)
 set -euo pipefail
 bus=$1
@@ -17,19 +18,12 @@ changed=$("$ss" write --bus "$bus" --node 1 --device xtrapulspac 0x60F9,2 $((ori
 [ "$changed" = $((original + 1)) ]
 
 "$ss" restore --bus "$bus" --node 1 --in "$work/DRIVEPAR.TXT" > "$work/restore.json"
-grep -q '"ok": true' "$work/restore.json"
+grep -q '"ok": true' "$work/restore.json"  # every object read back equal to the file
 [ "$("$ss" read --bus "$bus" --node 1 --device xtrapulspac 0x60F9,2 | raw)" = "$original" ]
-
-# A refused write exits 3 and says why.
-[ "$(exit_code "$ss" write --bus "$bus" --node 1 --device xtrapulspac 0x3410,1 99)" -eq 3 ]
-grep -q "outside 1..24" "$work/stderr.txt"
 
 # A corrupted file exits 3 naming its line; nothing is written.
 sed 's/^0x60F9,2=.*/0x60F9,2=banana/' "$work/DRIVEPAR.TXT" > "$work/bad_DRIVEPAR.TXT"
 line=$(grep -n '^0x60F9,2=' "$work/bad_DRIVEPAR.TXT" | cut -d: -f1)
 [ "$(exit_code "$ss" restore --bus "$bus" --node 1 --device xtrapulspac --in "$work/bad_DRIVEPAR.TXT")" -eq 3 ]
 grep -q "bad_DRIVEPAR.TXT:$line:" "$work/stderr.txt"
-
-# A node that does not answer exits 5.
-[ "$(exit_code "$ss" read --bus "$bus" --node 42 0x1000)" -eq 5 ]
 echo "cli round trip ok"

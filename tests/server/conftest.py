@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import contextlib
 import itertools
 import socket
 import sys
@@ -16,9 +17,17 @@ from servostudio.transport.rs232_framing import DRIVE_HEADER, HOST_HEADER, Frame
 
 _channels = itertools.count()
 
-# The simulated drives, the bus reader and the socket threads share one interpreter here: a short GIL switch
-# interval keeps each hand-over (and so every SDO round trip) at a fraction of a millisecond instead of 5 ms.
-sys.setswitchinterval(0.0002)
+
+
+@pytest.fixture(autouse=True, scope="module")
+def short_switch_interval():
+    """The simulated drives, the bus reader and the socket threads share one interpreter here: a short GIL switch
+    interval keeps each hand-over (and so every SDO round trip) at a fraction of a millisecond instead of 5 ms.
+    Only for these modules; the interpreter's setting is restored afterwards."""
+    previous = sys.getswitchinterval()
+    sys.setswitchinterval(0.0002)
+    yield
+    sys.setswitchinterval(previous)
 
 
 @pytest.fixture
@@ -144,6 +153,29 @@ def gateway(virtual_channel):
         item.close()
 
 
+FAST_SDO_RESPONSE = 0.2e-3  # the functional tests do not need the drive's realistic 1 ms, only its behaviour
+
+
+@contextlib.contextmanager
+def slow_drives(network, response_time: float = 2e-3):
+    """Drives that take ``response_time`` per SDO answer, so a long transfer is certainly still running when a test
+    cuts the link (≈ 370 objects × 2.2 ms ≈ 0.8 s, while a cut takes effect within about 0.2 s)."""
+    servers = [server for node in network.nodes.values() for server in (node.sdo, node.redirected_sdo)]
+    for server in servers:
+        server.response_time = response_time
+    try:
+        yield
+    finally:
+        for server in servers:
+            server.response_time = FAST_SDO_RESPONSE
+
+
+@pytest.fixture
+def slow():
+    """``with slow(network): …`` — drives answering SDO in 2 ms instead of 0.2 ms for the duration of the block."""
+    return slow_drives
+
+
 class Pacer:
     """Runs a SimulatedNetwork against the wall clock in 1 ms steps, releasing its lock between steps.
 
@@ -151,7 +183,7 @@ class Pacer:
     most one step for the lock, so SDO latency stays a few milliseconds instead of a whole catch-up batch.
     """
 
-    STEP = 0.001
+    STEP = 0.00025
     MAX_LAG = 0.05
 
     def __init__(self, network) -> None:
@@ -180,10 +212,15 @@ class Pacer:
 
 @pytest.fixture(scope="module")
 def sim_network(tmp_path_factory):
-    """Three simulated XtrapulsPac drives (nodes 1, 2, 3), paced against the wall clock (one per test module)."""
+    """Three simulated XtrapulsPac drives (nodes 1, 2, 3), paced against the wall clock, one per test module.
+
+    Tests do not rely on values another test of the module may have changed: each sets or reads back what it
+    checks.  (Module scope, not session: the pacer would otherwise take CPU from every later module.)
+    """
     from servostudio.sim.network import SimulatedNetwork
 
-    network = SimulatedNetwork("1,2,3", state_dir=tmp_path_factory.mktemp("sim-flash"))
+    network = SimulatedNetwork("1,2,3", state_dir=tmp_path_factory.mktemp("sim-flash"),
+                               sdo_response_time=FAST_SDO_RESPONSE)
     pacer = Pacer(network)
     yield network
     pacer.stop()
@@ -239,7 +276,8 @@ def _commission(drive) -> None:
     holds 0 there, and a restore (which validates against the dictionary) would rightly refuse its backup.
     Empty names get a text too: the simulated flash cannot store empty text in its DRIVEPAR.TXT.
     """
-    variables = [var for kind in (FileKind.DRIVEPAR, FileKind.USER_PAR) for var in backup_objects(drive, kind.save_type)]
+    variables = [var for kind in (FileKind.DRIVEPAR, FileKind.USER_PAR)
+                 for var in backup_objects(drive, kind.save_type)]
     reads = [(var, drive.submit_read(var)) for var in variables]
     for var, future in reads:
         value = future.result().raw

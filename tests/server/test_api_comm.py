@@ -42,7 +42,7 @@ def test_read_write_and_refusals(client):
     assert refused.status_code == 422
     assert "99 is outside 1..24" in refused.json()["detail"]
     assert client.put("/api/buses/bus0/nodes/1/objects/statusword", json={"value": 1}).status_code == 422
-    assert client.get("/api/buses/bus0/nodes/1/objects/0x2FFE").status_code == 422
+    assert client.get("/api/buses/bus0/nodes/1/objects/0x2FFE").status_code == 404
     assert client.get("/api/buses/nope/nodes/1/objects/0x1000").status_code == 404
     many = client.post("/api/buses/bus0/nodes/2/read", json={"objects": ["0x1000", "0x2FFE"]}).json()
     assert many[0]["value"]["raw"] > 0 and "not in the xtrapulspac dictionary" in many[1]["error"]

@@ -50,8 +50,11 @@ def test_abort_names_node_object_and_meaning(engine):
 
 
 def test_timeout_names_node_and_object(engine):
-    with pytest.raises(SdoTimeoutError, match=r"node 9, object 0x1000,0: no SDO response within 300 ms"):
+    with pytest.raises(SdoTimeoutError, match=r"node 9, object 0x1000,0: no SDO response within 300 ms on bus test "
+                                              r"\(request sent twice\)"):
         engine.upload(9, 0x1000, 0).result(3)
+    with pytest.raises(SdoTimeoutError, match=r"node 9, object 0x2003,0: no SDO response within 300 ms on bus test$"):
+        engine.download(9, 0x2003, 0, b"\x01").result(3)
     # The node's queue goes on after a timeout.
     assert engine.upload(1, 0x2001, 0).result(2) == b"\x07"
 
@@ -60,3 +63,66 @@ def test_link_down_fails_transfers_clearly(engine):
     engine.link.close()
     with pytest.raises(SdoLinkError, match="not connected"):
         engine.upload(1, 0x2001, 0).result(2)
+
+
+def test_a_read_whose_request_was_lost_is_sent_again(virtual_channel):
+    """A responder that ignores the first request of node 20, as if the frame had been lost."""
+    import threading
+
+    drive_side = can.Bus(interface="virtual", channel=virtual_channel, receive_own_messages=False)
+    requests: list[bytes] = []
+    stop = threading.Event()
+
+    def respond() -> None:
+        while not stop.is_set():
+            message = drive_side.recv(0.05)
+            if message is None or message.arbitration_id != 0x614:
+                continue
+            requests.append(bytes(message.data))
+            if len(requests) > 1:
+                drive_side.send(can.Message(arbitration_id=0x594, is_extended_id=False,
+                                            data=bytes([0x4F]) + bytes(message.data[1:4]) + bytes([42, 0, 0, 0])))
+
+    responder = threading.Thread(target=respond, daemon=True)
+    responder.start()
+    link = BusLink("lossy", lambda: can.Bus(interface="virtual", channel=virtual_channel, receive_own_messages=False))
+    assert link.start(wait=2.0)
+    try:
+        assert SdoEngine(link, timeout=0.2).upload(20, 0x2001, 0).result(3) == b"\x2a"
+        assert len(requests) == 2 and requests[0] == requests[1]
+    finally:
+        stop.set()
+        responder.join()
+        link.close()
+        drive_side.shutdown()
+
+
+def test_a_late_answer_about_another_object_is_ignored(virtual_channel):
+    """After a timeout, the drive's late reply must not be taken for the answer to the next request."""
+    import threading
+
+    drive_side = can.Bus(interface="virtual", channel=virtual_channel, receive_own_messages=False)
+    stop = threading.Event()
+
+    def respond() -> None:
+        while not stop.is_set():
+            message = drive_side.recv(0.05)
+            if message is None or message.arbitration_id != 0x615 or message.data[0] != 0x40:
+                continue
+            if bytes(message.data[1:3]) == b"\x02\x20":  # 0x2002: answer the earlier 0x2001 first (late), then it
+                late = bytes([0x4F, 0x01, 0x20, 0x00, 11, 0, 0, 0])
+                drive_side.send(can.Message(arbitration_id=0x595, is_extended_id=False, data=late))
+            reply = bytes([0x4F]) + bytes(message.data[1:4]) + bytes([22, 0, 0, 0])
+            drive_side.send(can.Message(arbitration_id=0x595, is_extended_id=False, data=reply))
+
+    responder = threading.Thread(target=respond, daemon=True)
+    responder.start()
+    link = BusLink("late", lambda: can.Bus(interface="virtual", channel=virtual_channel, receive_own_messages=False))
+    assert link.start(wait=2.0)
+    try:
+        assert SdoEngine(link, timeout=0.5).upload(21, 0x2002, 0).result(3) == bytes([22])
+    finally:
+        stop.set()
+        responder.join()
+        link.close()
+        drive_side.shutdown()

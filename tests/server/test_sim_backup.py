@@ -1,4 +1,4 @@
-"""Backup and restore against the simulated drives over socketcand and over the RS-232 link, including a link cut and its recovery."""
+"""Backup and restore against the simulated drives over socketcand and over the RS-232 link, with link cuts."""
 
 from __future__ import annotations
 
@@ -8,10 +8,10 @@ import pytest
 
 from servostudio.services.backup import (
     BackupError,
-    FileKind,
     RestoreValidationError,
     backup_file,
     restore_file,
+    run_per_drive,
 )
 from servostudio.formats.objectfile import read_object_file
 from servostudio.services.bus import ConnectionManager
@@ -24,16 +24,24 @@ def connection(endpoint, commission):
     bus = manager.open(endpoint.spec)
     assert bus.link.connected
     scan(bus)
-    for node in bus.nodes:
-        commission(bus.drive(node))  # once per transport: the drives keep their values between modules
+    results = run_per_drive([bus.drive(node) for node in bus.nodes], commission)  # once per transport
+    assert not [error for error in results.values() if isinstance(error, Exception)], results
     yield bus
     manager.close_all()
 
 
-def _cut_at(endpoint, fraction):
-    """A progress callback that cuts the link once ``fraction`` of the work is done."""
+def _cut_at_start(endpoint):
+    """A progress callback that cuts the link as soon as the transfers are queued (with slow drives: mid-way)."""
     def progress(event):
-        if event["done"] >= fraction * event["total"] and endpoint.server is not None:
+        if endpoint.server is not None:
+            endpoint.cut()
+    return progress
+
+
+def _cut_after_first_step(endpoint):
+    """Cut the link at the first progress step (5 % of the restore confirmed): some objects are written, most not."""
+    def progress(event):
+        if event["done"] > 0 and endpoint.server is not None:
             endpoint.cut()
     return progress
 
@@ -99,11 +107,12 @@ def test_corrupted_file_is_refused_with_its_line_and_nothing_is_written(connecti
     assert not any(0x601 <= frame.can_id <= 0x67F and frame.data[0] & 0xE0 == 0x20 for frame in frames)
 
 
-def test_link_cut_during_backup_leaves_no_file_and_link_recovers(connection, endpoint, tmp_path):
+def test_link_cut_during_backup_leaves_no_file_and_link_recovers(connection, endpoint, sim_network, slow,
+                                                                   tmp_path):
     drive = connection.drive(1)
     path = tmp_path / "DRIVEPAR.TXT"
-    with pytest.raises(BackupError, match="no file written"):
-        backup_file(drive, path, progress=_cut_at(endpoint, 0.3))
+    with slow(sim_network), pytest.raises(BackupError, match="no file written"):
+        backup_file(drive, path, progress=_cut_at_start(endpoint))
     assert not path.exists()
     assert list(tmp_path.iterdir()) == []  # no temporary file left either
     endpoint.restore()
@@ -111,13 +120,17 @@ def test_link_cut_during_backup_leaves_no_file_and_link_recovers(connection, end
     assert backup_file(drive, path).objects > 300
 
 
-def test_link_cut_during_restore_says_what_was_written(connection, endpoint, tmp_path):
+def test_link_cut_during_restore_says_what_was_written(connection, endpoint, sim_network, slow, tmp_path):
     drive = connection.drive(2)
     path = tmp_path / "DRIVEPAR.TXT"
     backup_file(drive, path)
-    result = restore_file(drive, path, progress=_cut_at(endpoint, 0.3))
+    with slow(sim_network):
+        result = restore_file(drive, path, progress=_cut_after_first_step(endpoint))
     assert not result.ok
     assert "objects had been written; nothing was stored to flash" in result.error
+    statuses = {outcome.status for outcome in result.outcomes}
+    assert "not written" in statuses and statuses & {"written", "verified"}  # exactly what reached the drive
+    assert len(result.outcomes) == len(read_object_file(path))
     assert result.stored == ""
     endpoint.restore()
     assert connection.link.wait_connected(5.0)

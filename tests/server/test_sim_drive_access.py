@@ -1,4 +1,4 @@
-"""Drive access against the simulated XtrapulsPac drives over socketcand and over the RS-232 link: scan, typed read/write, refusals."""
+"""Drive access against the simulated XtrapulsPac drives over socketcand and the RS-232 link: scan, typed values."""
 
 from __future__ import annotations
 

@@ -1,4 +1,8 @@
-"""The XtrapulsPac RS-232 link against the simulator: every drive reached through the one on the cable."""
+"""What only the RS-232 link has: scan range 1–63, a real (pseudo-)terminal device, link-loss events.
+
+Reads, writes, backup and restore over the link run in test_sim_drive_access.py and test_sim_backup.py, which
+take every test through socketcand and through the serial line.
+"""
 
 from __future__ import annotations
 
@@ -6,9 +10,6 @@ import time
 
 import pytest
 
-from servostudio.drive.access import DriveAccessError
-from servostudio.formats.objectfile import read_object_file
-from servostudio.services.backup import backup_file, restore_file
 from servostudio.services.bus import ConnectionManager
 from servostudio.services.scan import scan
 
@@ -25,39 +26,28 @@ def serial_bus(serial_line):
     manager.close_all()
 
 
-def test_scan_over_serial_reaches_every_drive(serial_bus):
+def test_scan_over_serial_reaches_every_drive_through_the_gateway(serial_bus, serial_line):
     found = scan(serial_bus)
     assert [info.node for info in found] == [1, 2, 3]
     assert all(info.device == "xtrapulspac" for info in found)
+    assert serial_line.gateway.node.node_id == 1  # nodes 2 and 3 answered through redirection
 
 
-@pytest.mark.parametrize("node", [1, 3])
-def test_read_and_write_through_the_gateway(serial_bus, node):
-    scan(serial_bus, nodes=[node])
-    drive = serial_bus.drive(node)
-    filter_var = drive.variable("0x60F9,2")
-    old = drive.read(filter_var).raw
-    new = filter_var.minimum if old != filter_var.minimum else filter_var.maximum
-    drive.write(filter_var, new)
-    assert drive.read(filter_var).raw == new
-    drive.write(filter_var, old)
-    drive.write("0x2004", f"serial axis {node}")  # segmented both ways through the link
-    assert drive.read("0x2004").raw.rstrip("\0") == f"serial axis {node}"
-    with pytest.raises(DriveAccessError, match="read-only"):
-        drive.write("statusword", 0)
+def test_pseudo_terminal_like_a_real_serial_port(sim_network):
+    from servostudio.sim.serial_link import SerialGateway, SerialPty
 
-
-def test_user_par_backup_and_restore_over_serial(serial_bus, tmp_path):
-    scan(serial_bus, nodes=[2])
-    drive = serial_bus.drive(2)
-    path = tmp_path / "USER_PAR.TXT"
-    assert backup_file(drive, path).objects > 50
-    entries = read_object_file(path)
-    first = drive.variable((entries[0].index, entries[0].sub))
-    drive.write(first, first.maximum if entries[0].value != first.maximum else first.minimum)
-    result = restore_file(drive, path, store=False)
-    assert result.ok, result.as_dict()
-    assert drive.read(first).raw == entries[0].value
+    gateway = SerialGateway(sim_network)
+    terminal = SerialPty(gateway).start()
+    manager = ConnectionManager()
+    try:
+        bus = manager.open(f"serial:{terminal.path}@57600")
+        assert bus.link.connected, bus.link.last_error
+        assert [info.node for info in scan(bus, nodes=[2, 9])] == [2]
+        assert bus.drive(2).read("0x1000").raw > 0
+    finally:
+        manager.close_all()
+        terminal.stop()
+        gateway.close()
 
 
 def test_link_loss_is_reported_and_recovered(serial_bus, serial_line):
@@ -72,5 +62,7 @@ def test_link_loss_is_reported_and_recovered(serial_bus, serial_line):
     assert "serial link lost" in lost_events()[0]["reason"]
     serial_line.restore()
     assert serial_bus.link.wait_connected(5.0)
+    back = [event for event in serial_bus.events_seen if event["type"] == "bus_state" and event["connected"]]
+    assert back
     scan(serial_bus, nodes=[1])
     assert serial_bus.drive(1).read("0x1000").raw > 0

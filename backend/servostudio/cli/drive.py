@@ -19,16 +19,15 @@ from servostudio.cli.output import (
     CommandError,
     emit,
 )
-from servostudio.drive.access import Drive, DriveAccessError
+from servostudio.drive.access import Drive, DriveAccessError, UnknownObjectError
 from servostudio.drive.cia402 import State
-from servostudio.drive.control import fault_report, read_state, reset_faults, set_state
+from servostudio.drive.control import StateChangeError, fault_report, read_state, reset_faults, set_state
 from servostudio.drive.link import LinkDownError
 from servostudio.drive.nmt import NmtCommand, send_nmt
 from servostudio.drive.profiles import ProfileError
 from servostudio.drive.sdo import SdoError
 from servostudio.services.backup import (
     BackupError,
-    FileKind,
     RestoreValidationError,
     backup_drive,
     backup_file,
@@ -100,11 +99,11 @@ def _run(args: argparse.Namespace, handler: Callable[[argparse.Namespace, BusCon
             raise CommandError(f"bus {args.bus}: not connected ({connection.link.last_error or 'no answer'})",
                                EXIT_COMMUNICATION)
         return emit(handler(args, connection))
+    except (UnknownBusOrNode, ProfileError, UnknownObjectError) as error:
+        raise CommandError(str(error), EXIT_NOT_FOUND) from None
     except (RestoreValidationError, DriveAccessError, BusSpecError, ValueError) as error:
         raise CommandError(str(error), EXIT_INVALID_INPUT) from None
-    except (UnknownBusOrNode, ProfileError) as error:
-        raise CommandError(str(error), EXIT_NOT_FOUND) from None
-    except (SdoError, BackupError, LinkDownError) as error:
+    except (SdoError, BackupError, LinkDownError, StateChangeError) as error:
         raise CommandError(str(error), EXIT_COMMUNICATION) from None
     finally:
         manager.close_all()
@@ -161,6 +160,7 @@ def _restore(args: argparse.Namespace, connection: BusConnection) -> object:
     if len(drives) == 1 and source.is_file():
         result = restore_file(drives[0], source, store=not args.no_store)
         if not result.ok:
+            emit(result.as_dict())
             raise BackupError(_restore_failure(result.as_dict()))
         return result.as_dict()
 
@@ -168,7 +168,8 @@ def _restore(args: argparse.Namespace, connection: BusConnection) -> object:
         folder = source / f"node{drive.node}"
         kinds = [kind for kind in drive_file_kinds(drive) if (folder / kind.value).is_file()]
         if not kinds:
-            raise RestoreValidationError(f"{folder}: no DRIVEPAR.TXT, USER_PAR.TXT or SEQUENCE.TXT for node {drive.node}")
+            raise RestoreValidationError(f"{folder}: no DRIVEPAR.TXT, USER_PAR.TXT or SEQUENCE.TXT "
+                                         f"for node {drive.node}")
         return [restore_file(drive, folder / kind.value, kind, store=not args.no_store) for kind in kinds]
 
     results = run_per_drive(drives, restore_all)

@@ -1,7 +1,8 @@
 """`servostudio project …`: the project store from the command line (same service as the REST API).
 
-Exit codes: 0 done; 3 refused (bad value, rule broken, conflicting change, unsafe archive; nothing written);
-4 not found (project, axis, object, motor, template).
+Exit codes: 0 done; 3 refused (bad value, rule broken, conflicting change, unsafe archive, a drive that is not the
+axis's device; nothing written); 4 not found (project, axis, object, motor, template); 5 communication (bus not
+connected, drive not answering or refusing).
 """
 
 from __future__ import annotations
@@ -10,10 +11,15 @@ import argparse
 import functools
 from pathlib import Path
 
-from servostudio.cli.output import EXIT_INVALID_INPUT, EXIT_NOT_FOUND, CommandError, emit
+from servostudio.cli.output import EXIT_COMMUNICATION, EXIT_INVALID_INPUT, EXIT_NOT_FOUND, CommandError, emit
+from servostudio.drive.link import LinkDownError
+from servostudio.drive.sdo import SdoError
 from servostudio.od import BUILTIN_EDS_DIR, EdsLibrary
 from servostudio.od.library import DEFAULT_USER_EDS_DIR
+from servostudio.services.backup import BackupError
+from servostudio.services.bus import ConnectionManager
 from servostudio.services.projects import Axis, Bus, ProjectError, ProjectNotFound, ProjectService
+from servostudio.services.projects.errors import DriveUnavailable
 from servostudio.services.projects.fsutil import atomic_write
 from servostudio.services.projects.jsonview import (
     choice_view,
@@ -24,8 +30,10 @@ from servostudio.services.projects.jsonview import (
     summaries,
     template_view,
 )
+from servostudio.services.projects.live import LiveProjects
 from servostudio.services.projects.motors import motor_from_text
 from servostudio.services.projects.templates import templates_for
+from servostudio.transport.spec import BusSpecError
 
 
 def register(commands: argparse._SubParsersAction) -> None:
@@ -41,6 +49,11 @@ def register(commands: argparse._SubParsersAction) -> None:
 
     def revision(parser: argparse.ArgumentParser) -> None:
         parser.add_argument("--revision", help="refuse the change if the project changed since this revision")
+
+    def via(parser: argparse.ArgumentParser) -> None:
+        parser.add_argument("--via", action="append", default=[], metavar="BUS=SPEC",
+                            help="reach a project bus through another bus spec for this command, e.g. "
+                            "sim=socketcand:127.0.0.1:29536 (repeatable)")
 
     action("list", _list, "projects of the store")
     create = action("create", _create, "create an empty project")
@@ -102,11 +115,42 @@ def register(commands: argparse._SubParsersAction) -> None:
     params.add_argument("--only-set", action="store_true", help="only objects the project files set")
     params.add_argument("--only-differences", action="store_true", help="only values that differ from default")
     params.add_argument("--all", action="store_true", help="also objects not saved in a drive file")
-    compare = action("compare", _compare, "compare project values with the dictionary defaults")
+    compare = action("compare", _compare, "compare project values with the dictionary defaults (and the drive)")
     compare.add_argument("name")
     compare.add_argument("axis")
     compare.add_argument("--group")
     compare.add_argument("--only-differences", action="store_true")
+    compare.add_argument("--drive", action="store_true", help="add the live drive's values (opens the axis's bus)")
+    via(compare)
+    take = action("take", _take, "store the drive's values in the project (default: every differing object)")
+    take.add_argument("name")
+    take.add_argument("axis")
+    take.add_argument("addresses", nargs="*", metavar="ADDRESS")
+    revision(take)
+    via(take)
+    write = action("write", _write, "write the project's values to the drive (default: every differing object)")
+    write.add_argument("name")
+    write.add_argument("axis")
+    write.add_argument("addresses", nargs="*", metavar="ADDRESS")
+    write.add_argument("--store", action="store_true", help="save the drive's parameters to flash afterwards")
+    via(write)
+    commission = action("commission", _commission, "check every axis's drive; --download or --upload the files")
+    commission.add_argument("name")
+    direction = commission.add_mutually_exclusive_group()
+    direction.add_argument("--download", dest="direction", action="store_const", const="download",
+                           help="project values → drives (validated, written, verified, stored)")
+    direction.add_argument("--upload", dest="direction", action="store_const", const="upload",
+                           help="drives' files → project")
+    commission.add_argument("--axis", action="append", dest="axes", metavar="AXIS", help="only this axis (repeatable)")
+    revision(commission)
+    via(commission)
+    scan = action("scan", _scan, "scan a bus and add an axis for every identified node")
+    scan.add_argument("name")
+    scan.add_argument("--bus", required=True, metavar="BUS_OR_SPEC", help="a bus of the project or a bus spec, e.g. "
+                      "sim or socketcand:127.0.0.1:29536 (a new spec is added to the project)")
+    scan.add_argument("--bus-name", help="name of the new bus (default: derived from the spec)")
+    scan.add_argument("--create", action="store_true", help="create the project if it does not exist")
+    revision(scan)
 
     archive = action("archive", _archive, "pack a project into one zip file")
     archive.add_argument("name")
@@ -127,7 +171,10 @@ def register(commands: argparse._SubParsersAction) -> None:
     select.add_argument("name")
     select.add_argument("axis")
     select.add_argument("reference")
+    select.add_argument("--drive", action="store_true", help="write the motor to the live drive and read back what "
+                        "it derived")
     revision(select)
+    via(select)
     templates = action("template-list", _template_list, "Device Config templates of a device")
     templates.add_argument("--device", default="xtrapulspac")
     apply = action("template-apply", _template_apply, "apply a Device Config template to an axis")
@@ -149,8 +196,31 @@ def _run(handler, args: argparse.Namespace) -> int:
         return emit(handler(service, args))
     except ProjectNotFound as error:
         raise CommandError(str(error), EXIT_NOT_FOUND) from None
-    except ProjectError as error:
+    except (DriveUnavailable, SdoError, LinkDownError, BackupError) as error:
+        raise CommandError(str(error), EXIT_COMMUNICATION) from None
+    except (ProjectError, BusSpecError) as error:
         raise CommandError(str(error), EXIT_INVALID_INPUT) from None
+    finally:
+        manager = getattr(args, "connections", None)
+        if manager is not None:
+            manager.close_all()
+
+
+def _live(service: ProjectService, args: argparse.Namespace) -> LiveProjects:
+    """Live commands open the buses they need; ``_run`` closes them when the command ends."""
+    if getattr(args, "connections", None) is None:
+        args.connections = ConnectionManager(service.library)
+    return LiveProjects(service, args.connections)
+
+
+def _via(args: argparse.Namespace) -> dict[str, str]:
+    routes = {}
+    for text in getattr(args, "via", []):
+        bus, equals, spec = text.partition("=")
+        if not equals or not bus or not spec:
+            raise CommandError(f"--via {text!r}: expected BUS=SPEC", EXIT_INVALID_INPUT)
+        routes[bus] = spec
+    return routes
 
 
 def _list(service: ProjectService, args: argparse.Namespace) -> list[dict]:
@@ -230,9 +300,45 @@ def _params(service: ProjectService, args: argparse.Namespace) -> dict:
 
 
 def _compare(service: ProjectService, args: argparse.Namespace) -> dict:
-    rows, revision = service.parameters.compare(args.name, args.axis, group=args.group,
-                                                only_differences=args.only_differences)
-    return {"columns": ["project", "default"], "rows": [compare_view(row) for row in rows], "revision": revision}
+    if not args.drive:
+        rows, revision = service.parameters.compare(args.name, args.axis, group=args.group,
+                                                    only_differences=args.only_differences)
+        return {"columns": ["project", "default"], "rows": [compare_view(row) for row in rows], "revision": revision}
+    live = _live(service, args).compare(args.name, args.axis, group=args.group, only_differences=args.only_differences,
+                                  buses=_via(args))
+    return {"columns": ["drive", "project", "default"], "rows": [compare_view(row) for row in live.rows],
+            "revision": live.revision, "refused": live.refused}
+
+
+def _take(service: ProjectService, args: argparse.Namespace) -> dict:
+    change = _live(service, args).take(args.name, args.axis, args.addresses or None, args.revision, _via(args))
+    return {"parameters": [parameter_view(row) for row in change.rows], "revision": change.revision}
+
+
+def _write(service: ProjectService, args: argparse.Namespace) -> dict:
+    report = _live(service, args).write(args.name, args.axis, args.addresses or None, args.store, _via(args))
+    if not report.ok:
+        emit(report.as_dict())
+        raise CommandError(f"axis '{args.axis}': the drive refused some values (see the report)", EXIT_COMMUNICATION)
+    return report.as_dict()
+
+
+def _commission(service: ProjectService, args: argparse.Namespace) -> dict:
+    report = _live(service, args).commission(args.name, args.direction or "check", args.axes, args.revision, _via(args))
+    if report.ok:
+        return report.as_dict()
+    emit(report.as_dict())
+    failed = [axis for axis in report.axes if not axis.ok]
+    only_mismatch = all(axis.link.status == "wrong_device" for axis in failed)
+    names = ", ".join(axis.link.axis.name for axis in failed)
+    raise CommandError(f"project '{args.name}': axes {names} not commissioned (see the report)",
+                       EXIT_INVALID_INPUT if only_mismatch else EXIT_COMMUNICATION)
+
+
+def _scan(service: ProjectService, args: argparse.Namespace) -> dict:
+    report = _live(service, args).scan(args.name, args.bus, args.bus_name, args.revision, args.create)
+    return {"bus": report.bus.name, "bus_added": report.bus_added, "nodes": [node.as_dict() for node in report.nodes],
+            "project": project_view(report.snapshot)}
 
 
 def _archive(service: ProjectService, args: argparse.Namespace) -> dict:
@@ -267,6 +373,9 @@ def _motor_remove(service: ProjectService, args: argparse.Namespace) -> dict:
 
 
 def _motor_select(service: ProjectService, args: argparse.Namespace) -> dict:
+    if args.drive:
+        return choice_view(_live(service, args).select_motor(args.name, args.axis, args.reference, args.revision,
+                                                       _via(args)))
     return choice_view(service.select_motor(args.name, args.axis, args.reference, args.revision))
 
 

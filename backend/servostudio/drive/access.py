@@ -14,7 +14,7 @@ from concurrent.futures import Future
 
 from servostudio.drive.profiles import DeviceProfile, profile_for
 from servostudio.drive.sdo import SdoEngine
-from servostudio.drive.values import ObjectValue, Raw, ValueInputError, decode_raw, parse_input
+from servostudio.drive.values import ObjectValue, Raw, decode_raw, parse_input
 from servostudio.od.datatypes import DataType, encode
 from servostudio.od.model import Access, ObjectDictionary, Variable
 
@@ -25,6 +25,10 @@ DEFAULT_WAIT = 120.0
 
 class DriveAccessError(ValueError):
     """A read or write refused before anything was sent (unknown object, access, value)."""
+
+
+class UnknownObjectError(DriveAccessError, LookupError):
+    """The object is not in the drive's dictionary (or no dictionary is known for the drive)."""
 
 
 class Drive:
@@ -46,14 +50,15 @@ class Drive:
         if isinstance(key, str) and self.profile.has(key):
             key = self.profile.address(key)
         if self.dictionary is None:
-            raise DriveAccessError(f"node {self.node}: no object dictionary known for this drive")
+            raise UnknownObjectError(f"node {self.node}: no object dictionary known (the node did not answer or "
+                                     "matches no EDS of the library); scan the bus or name the device")
         try:
             if isinstance(key, tuple):
                 return self.dictionary[key]
             return self.dictionary.find(key)
         except KeyError:
             shown = f"0x{key[0]:04X},{key[1]}" if isinstance(key, tuple) else repr(key)
-            raise DriveAccessError(f"node {self.node}: object {shown} is not in the {self.dictionary.device} "
+            raise UnknownObjectError(f"node {self.node}: object {shown} is not in the {self.dictionary.device} "
                                    "dictionary") from None
 
     # -- reads ---------------------------------------------------------------------------------------------------
@@ -61,18 +66,12 @@ class Drive:
         """Queue a read; the future gives an ObjectValue."""
         if not variable.access.readable:
             raise DriveAccessError(f"node {self.node}: {variable.label} is write-only")
-        result: Future = Future()
-        upload = self.engine.upload(self.node, variable.index, variable.subindex, timeout)
-        upload.add_done_callback(lambda done: _chain(done, result, lambda data: ObjectValue(
-            self.node, variable, decode_raw(variable, data))))
-        return result
+        return self.engine.upload(self.node, variable.index, variable.subindex, timeout,
+                                  convert=lambda data: ObjectValue(self.node, variable, decode_raw(variable, data)))
 
     def read(self, key: str | tuple[int, int] | Variable, timeout: float | None = None) -> ObjectValue:
         variable = key if isinstance(key, Variable) else self.variable(key)
         return self.submit_read(variable, timeout).result(DEFAULT_WAIT + (timeout or 0))
-
-    def read_raw(self, key: str | tuple[int, int]) -> Raw:
-        return self.read(key).raw
 
     # -- writes --------------------------------------------------------------------------------------------------
     def prepare_write(self, key: str | tuple[int, int] | Variable, value: object, physical: bool = False,
@@ -93,10 +92,8 @@ class Drive:
                      timeout: float | None = None) -> Future:
         """Check, then queue a write; the future gives the ObjectValue written."""
         variable, raw, data = self.prepare_write(key, value, physical)
-        result: Future = Future()
-        download = self.engine.download(self.node, variable.index, variable.subindex, data, timeout)
-        download.add_done_callback(lambda done: _chain(done, result, lambda _: ObjectValue(self.node, variable, raw)))
-        return result
+        return self.engine.download(self.node, variable.index, variable.subindex, data, timeout,
+                                    convert=lambda _: ObjectValue(self.node, variable, raw))
 
     def write(self, key: str | tuple[int, int] | Variable, value: object, physical: bool = False,
               timeout: float | None = None) -> ObjectValue:
@@ -110,15 +107,3 @@ class Drive:
         """Write a procedure's signature (decisions.md §4), e.g. "save" → 0x1010,1 = 'save'."""
         (index, sub), value = self.profile.signature(procedure)
         self.write_raw_bytes(index, sub, value.to_bytes(4, "little"), timeout)
-
-
-def _chain(done: Future, result: Future, convert) -> None:
-    """Complete ``result`` from ``done`` through ``convert`` (errors pass through)."""
-    error = done.exception()
-    if error is not None:
-        result.set_exception(error)
-        return
-    try:
-        result.set_result(convert(done.result()))
-    except (ValueError, ValueInputError) as conversion_error:
-        result.set_exception(conversion_error)

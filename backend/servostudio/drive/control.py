@@ -23,19 +23,22 @@ def read_state(drive: Drive) -> tuple[State | None, int]:
 
 
 def set_state(drive: Drive, target: State, step_timeout: float = STEP_TIMEOUT) -> State:
-    """Walk the CiA 402 state machine to ``target`` one command at a time, checking each step."""
+    """Walk the CiA 402 state machine to ``target`` one command at a time, checking each step.
+
+    A drive in FAULT is not reset on the way: resetting a fault is the user's decision (``reset_faults``), so the
+    error names the active faults instead.
+    """
     for _ in range(8):
         state, statusword = read_state(drive)
         if state is None:
             raise StateChangeError(f"node {drive.node}: status word 0x{statusword:04X} is no CiA 402 state")
+        if state in (State.FAULT, State.FAULT_REACTION_ACTIVE):
+            raise StateChangeError(f"node {drive.node}: in {state.value}{_fault_names(drive)}; reset the fault first")
         command = next_command(state, target)
         if command is None:
             return state
-        if command is Command.FAULT_RESET:
-            reset_faults(drive)
-        else:
-            controlword = int(drive.read("controlword").raw) if drive.variable("controlword").access.readable else 0
-            drive.write("controlword", apply_command(controlword, command))
+        controlword = int(drive.read("controlword").raw) if drive.variable("controlword").access.readable else 0
+        drive.write("controlword", apply_command(controlword, command))
         _wait_for_change(drive, state, step_timeout)
     state, statusword = read_state(drive)
     raise StateChangeError(f"node {drive.node}: stuck in {state.value if state else '?'} "
@@ -46,21 +49,24 @@ def _wait_for_change(drive: Drive, previous: State, timeout: float) -> None:
     deadline = time.monotonic() + timeout
     while time.monotonic() < deadline:
         state, statusword = read_state(drive)
-        if state is not previous and state is not State.FAULT_REACTION_ACTIVE:
+        if state is not previous:
             return
         time.sleep(POLL_PERIOD)
     state, statusword = read_state(drive)
-    report = fault_report(drive) if state is State.FAULT else None
-    detail = f"; faults: {', '.join(f.name for f in report.faults)}" if report and report.faults else ""
     raise StateChangeError(f"node {drive.node}: still {state.value if state else '?'} (status word "
-                           f"0x{statusword:04X}) {timeout:.1f} s after the command{detail}")
+                           f"0x{statusword:04X}) {timeout:.1f} s after the command")
+
+
+def _fault_names(drive: Drive) -> str:
+    faults = fault_report(drive).faults
+    return f" ({', '.join(fault.name for fault in faults)})" if faults else ""
 
 
 def reset_faults(drive: Drive) -> None:
     """Rising edge of control word bit 7, then bit 7 cleared again (the manual: the host must clear it)."""
     controlword = int(drive.read("controlword").raw) & ~0x80
     drive.write("controlword", controlword)
-    drive.write("controlword", apply_command(controlword, Command.FAULT_RESET) | (controlword & 0x0F00))
+    drive.write("controlword", apply_command(controlword, Command.FAULT_RESET))
     drive.write("controlword", controlword & ~0x8F)
 
 
@@ -75,7 +81,8 @@ class FaultReport:
     warnings: list[FaultInfo] = field(default_factory=list)
 
     def as_dict(self) -> dict[str, object]:
-        return {"node": self.node, "state": self.state, "statusword": self.statusword, "fault": bool(self.statusword & 8),
+        return {"node": self.node, "state": self.state, "statusword": self.statusword,
+                "fault": bool(self.statusword & 8),
                 "error_code": self.error_code, "error_text": self.error_text,
                 "faults": [item.as_dict() for item in self.faults],
                 "warnings": [item.as_dict() for item in self.warnings]}

@@ -61,7 +61,8 @@ _CIA402_CLASSES = [
 _CIA402_KNOWN = {
     0x2310: "continuous over current", 0x2350: "load level fault (I²t, thermal state)", 0x3210: "DC link overvoltage",
     0x3220: "DC link undervoltage", 0x4210: "excess temperature device", 0x4290: "motor temperature",
-    0x5112: "supply low voltage", 0x6320: "parameter error", 0x7303: "resolver fault", 0x7305: "incremental sensor fault",
+    0x5112: "supply low voltage", 0x6320: "parameter error", 0x7303: "resolver fault",
+    0x7305: "incremental sensor fault",
     0x8130: "life guard error or heartbeat error", 0x8400: "velocity speed controller", 0x8611: "following error",
     0x8680: "software position limit",
 }

@@ -40,27 +40,30 @@ class BusLink:
         self._bus: can.BusABC | None = None
         self._send_lock = threading.Lock()
         self._subscribers: dict[int, list[FrameCallback]] = {}
-        self._all_frames: list[FrameCallback] = []
         self._state_listeners: list[StateCallback] = []
         self._tickers: list[TickCallback] = []
         self._stop = threading.Event()
         self._connected = threading.Event()
+        self._first_attempt = threading.Event()
         self._thread: threading.Thread | None = None
         self._next_tick = 0.0
 
     # -- lifecycle ---------------------------------------------------------------------------------------------
     def start(self, wait: float = 0.0) -> bool:
-        """Start the reader thread; with ``wait`` > 0 block until connected or that many seconds passed."""
+        """Start the reader thread; with ``wait`` > 0 block until the first attempt to open the interface
+        succeeded or failed (at most that many seconds).  Returns whether the bus is connected."""
         if self._thread is None:
             self._thread = threading.Thread(target=self._run, name=f"bus {self.name}", daemon=True)
             self._thread.start()
-        return self._connected.wait(wait) if wait > 0 else self.connected
+        if wait > 0:
+            self._first_attempt.wait(wait)
+        return self.connected
 
     def close(self) -> None:
         self._stop.set()
         if self._thread is not None and self._thread is not threading.current_thread():
             self._thread.join(timeout=2.0)
-        self._drop_bus("closed")
+        self._drop_bus()
 
     @property
     def connected(self) -> bool:
@@ -73,11 +76,15 @@ class BusLink:
     def send(self, cob_id: int, data: bytes) -> None:
         bus = self._bus
         if bus is None or not self.connected:
-            raise LinkDownError(f"bus {self.name} is not connected" + (f" ({self.last_error})" if self.last_error else ""))
-        message = can.Message(arbitration_id=cob_id, data=data, is_extended_id=False)
+            detail = f" ({self.last_error})" if self.last_error else ""
+            raise LinkDownError(f"bus {self.name} is not connected{detail}")
+        fast_send = getattr(bus, "send_frame", None)  # our own buses skip building a python-can Message
         try:
             with self._send_lock:
-                bus.send(message)
+                if fast_send is not None:
+                    fast_send(cob_id, data)
+                else:
+                    bus.send(can.Message(arbitration_id=cob_id, data=data, is_extended_id=False))
         except (can.CanError, OSError) as error:
             self._link_lost(str(error))
             raise LinkDownError(f"bus {self.name}: {error}") from error
@@ -89,10 +96,6 @@ class BusLink:
         callbacks = self._subscribers.get(cob_id, [])
         if callback in callbacks:
             callbacks.remove(callback)
-
-    def subscribe_all(self, callback: FrameCallback) -> None:
-        """Every received frame (monitors, logging)."""
-        self._all_frames.append(callback)
 
     def on_state(self, callback: StateCallback) -> None:
         """``callback(connected, reason)`` on every change of the link state."""
@@ -112,6 +115,7 @@ class BusLink:
                 message = self._bus.recv(POLL_INTERVAL)
             except (can.CanError, OSError, ValueError) as error:
                 self._link_lost(str(error))
+                self._stop.wait(min(self.reconnect_interval, 0.2))  # let the other side settle before reopening
                 continue
             if message is not None and not message.is_error_frame and not message.is_remote_frame:
                 self._dispatch(message.arbitration_id, bytes(message.data), message.timestamp or time.time())
@@ -129,22 +133,23 @@ class BusLink:
                 log.warning("bus %s: %s", self.name, reason)
                 self.last_error = reason
                 self._notify(False, reason)
+            self._first_attempt.set()
             self._stop.wait(self.reconnect_interval)
             return
         self._bus = bus
         self.last_error = ""
         self._connected.set()
+        self._first_attempt.set()
         log.info("bus %s connected", self.name)
         self._notify(True, "connected")
 
     def _link_lost(self, reason: str) -> None:
-        if self._drop_bus(reason):
+        if self._drop_bus():
             log.warning("bus %s lost: %s", self.name, reason)
             self.last_error = reason
             self._notify(False, reason)
-            self._stop.wait(min(self.reconnect_interval, 0.2))
 
-    def _drop_bus(self, reason: str) -> bool:
+    def _drop_bus(self) -> bool:
         was_connected = self._connected.is_set()
         self._connected.clear()
         bus, self._bus = self._bus, None
@@ -156,9 +161,7 @@ class BusLink:
         return was_connected
 
     def _dispatch(self, cob_id: int, data: bytes, timestamp: float) -> None:
-        for callback in self._subscribers.get(cob_id, ()):
-            _safely(callback, cob_id, data, timestamp)
-        for callback in self._all_frames:
+        for callback in tuple(self._subscribers.get(cob_id, ())):
             _safely(callback, cob_id, data, timestamp)
 
     def _tick(self, now: float) -> None:

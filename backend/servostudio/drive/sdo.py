@@ -6,6 +6,9 @@ wait on it and the event loop never does.  Each node has a FIFO: the next reques
 previous response arrives, from the reader thread itself, so a backup of many drives keeps every drive busy and
 the bus full without one thread per drive.
 
+A read whose request got no answer at all is sent once more before it times out (reads have no side effect, and
+one lost frame should not fail a 400-object backup); writes are never repeated.
+
 Block transfers are not used: the dictionaries' values fit in one expedited frame or a few segments, where a
 block transfer needs more frames than a segmented one.
 """
@@ -17,6 +20,7 @@ import threading
 import time
 from collections import deque
 from concurrent.futures import Future
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 from servostudio.drive.abort_codes import abort_text
@@ -25,6 +29,7 @@ from servostudio.drive.link import BusLink, LinkDownError
 SDO_REQUEST = 0x600
 SDO_RESPONSE = 0x580
 DEFAULT_TIMEOUT = 0.5
+UPLOAD_RETRIES = 1  # a read has no side effect: one lost frame should not fail a 400-object backup
 ABORT_TIMEOUT = 0x05040000
 ABORT_COMMAND = 0x05040001
 ABORT_TOGGLE = 0x05030000
@@ -72,9 +77,24 @@ class _Transfer:
     offset: int = 0
     segmented: bool = False
     abort_on_timeout: bool = True
+    retries: int = 0  # times the initiate request is sent again when it got no answer at all
+    answered: bool = False
+    repeated: bool = False
+    convert: Callable[[object], object] | None = None  # applied to the result before the future gets it
 
     def multiplexer(self) -> bytes:
         return struct.pack("<HB", self.index, self.sub)
+
+
+def _stale(transfer: _Transfer, data: bytes) -> bool:
+    """An answer that belongs to an earlier request: a late reply about another object (after a timeout), or a
+    second reply to a repeated initiate request while the segments are already running."""
+    command = data[0]
+    initiate_reply = command >> 5 in (2, 3)
+    if (initiate_reply or command == 0x80) and data[1:4] != transfer.multiplexer():
+        return True
+    in_segments = transfer.offset > 0 if transfer.download is not None else transfer.segmented
+    return initiate_reply and in_segments
 
 
 class SdoEngine:
@@ -90,19 +110,23 @@ class SdoEngine:
         link.on_state(self._link_state)
 
     # -- public API --------------------------------------------------------------------------------------------
-    def upload(self, node: int, index: int, sub: int, timeout: float | None = None, probe: bool = False) -> Future:
-        """Read an object; the future gives its bytes.
+    def upload(self, node: int, index: int, sub: int, timeout: float | None = None, probe: bool = False,
+               convert: Callable[[bytes], object] | None = None) -> Future:
+        """Read an object; the future gives its bytes, or ``convert(bytes)`` (a ValueError fails the future).
 
         A ``probe`` (scan) sends no abort when the node stays silent: there is nobody to tell, and on a slow serial
         link 127 useless abort frames would cost most of a second.
         """
-        return self._submit(_Transfer(node, index, sub, timeout or self.timeout, abort_on_timeout=not probe))
+        return self._submit(_Transfer(node, index, sub, timeout or self.timeout, abort_on_timeout=not probe,
+                                      convert=convert, retries=0 if probe else UPLOAD_RETRIES))
 
-    def download(self, node: int, index: int, sub: int, data: bytes, timeout: float | None = None) -> Future:
-        """Write an object; the future gives None once the drive confirmed."""
+    def download(self, node: int, index: int, sub: int, data: bytes, timeout: float | None = None,
+                 convert: Callable[[None], object] | None = None) -> Future:
+        """Write an object; the future gives None (or ``convert(None)``) once the drive confirmed."""
         if not data:
             raise ValueError("an SDO download needs at least one byte")
-        return self._submit(_Transfer(node, index, sub, timeout or self.timeout, download=bytes(data)))
+        return self._submit(_Transfer(node, index, sub, timeout or self.timeout, download=bytes(data),
+                                      convert=convert))
 
     # -- internals ---------------------------------------------------------------------------------------------
     def _submit(self, transfer: _Transfer) -> Future:
@@ -154,8 +178,9 @@ class SdoEngine:
         node = cob_id - SDO_RESPONSE
         with self._lock:
             transfer = self._active.get(node)
-            if transfer is None or len(data) < 8:
+            if transfer is None or len(data) < 8 or _stale(transfer, data):
                 return
+            transfer.answered = True
             try:
                 follow_up = self._advance(transfer, data)
             except SdoError as error:
@@ -193,7 +218,8 @@ class SdoEngine:
             raise SdoError(transfer.node, transfer.index, transfer.sub, "segment toggle bit not alternated")
         transfer.received += data[1 : 8 - ((command >> 1) & 0x7)]
         if command & 0x01:  # last segment
-            self._finish(transfer, bytes(transfer.received))
+            size = transfer.expected_size
+            self._finish(transfer, bytes(transfer.received[:size] if size is not None else transfer.received))
             return None
         transfer.toggle ^= 1
         return bytes([0x60 | transfer.toggle << 4]) + bytes(7)
@@ -226,7 +252,8 @@ class SdoEngine:
 
     def _abort(self, transfer: _Transfer, code: int) -> None:
         try:
-            self.link.send(SDO_REQUEST + transfer.node, bytes([0x80]) + transfer.multiplexer() + struct.pack("<I", code))
+            frame = bytes([0x80]) + transfer.multiplexer() + struct.pack("<I", code)
+            self.link.send(SDO_REQUEST + transfer.node, frame)
         except LinkDownError:
             pass
 
@@ -236,6 +263,11 @@ class SdoEngine:
             del self._active[transfer.node]
         if transfer.future.done():
             return
+        if not isinstance(outcome, Exception) and transfer.convert is not None:
+            try:
+                outcome = transfer.convert(outcome)
+            except ValueError as error:
+                outcome = error
         if isinstance(outcome, Exception):
             transfer.future.set_exception(outcome)
         else:
@@ -245,11 +277,18 @@ class SdoEngine:
         with self._lock:
             expired = [transfer for transfer in self._active.values() if now > transfer.deadline]
             for transfer in expired:
+                if transfer.retries > 0 and not transfer.answered:
+                    transfer.retries -= 1
+                    transfer.repeated = True
+                    if not self._send(transfer, self._initiate(transfer)):
+                        self._start_next(transfer.node)
+                    continue
                 if transfer.abort_on_timeout:
                     self._abort(transfer, ABORT_TIMEOUT)
+                sent = " (request sent twice)" if transfer.repeated else ""
                 self._finish(transfer, SdoTimeoutError(
                     transfer.node, transfer.index, transfer.sub,
-                    f"no SDO response within {transfer.timeout * 1000:.0f} ms on bus {self.link.name}"))
+                    f"no SDO response within {transfer.timeout * 1000:.0f} ms on bus {self.link.name}{sent}"))
                 self._start_next(transfer.node)
 
     def _link_state(self, connected: bool, reason: str) -> None:

@@ -18,9 +18,10 @@ from __future__ import annotations
 
 import enum
 import struct
+import threading
 import time
 from collections.abc import Callable, Iterable
-from concurrent.futures import Future, ThreadPoolExecutor
+from concurrent.futures import Future, ThreadPoolExecutor, wait
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -120,7 +121,8 @@ def backup_objects(drive: Drive, save_type: SaveType) -> list[Variable]:
             and var.data_type not in (DataType.DOMAIN, DataType.OCTET_STRING)]
 
 
-def backup_file(drive: Drive, path: Path, kind: FileKind | None = None, progress: Progress | None = None) -> BackupResult:
+def backup_file(drive: Drive, path: Path, kind: FileKind | None = None,
+                progress: Progress | None = None) -> BackupResult:
     """Back up one file of one drive; the file is written atomically at the end."""
     kind = kind or FileKind.from_path(path)
     started = time.monotonic()
@@ -146,17 +148,30 @@ def _read_all(drive: Drive, variables: list[Variable], kind: FileKind, progress:
               ) -> tuple[list[ObjectValue], list[dict[str, str]]]:
     futures = [(var, drive.submit_read(var)) for var in variables]  # all queued: the engine pipelines them
     reporter = _Reporter(progress, "backup", drive.node, kind.value, len(futures))
+    _wait_all([future for _, future in futures], reporter)
     values, skipped = [], []
     for var, future in futures:
         try:
             values.append(future.result())
         except SdoAbortError as error:
             skipped.append({"object": var.label, "reason": error.reason})
+        except ValueError as error:  # the drive answered bytes that are no value of the object's type
+            skipped.append({"object": var.label, "reason": str(error)})
         except SdoError as error:
             _cancel(future for _, future in futures)
             raise BackupError(f"backup of node {drive.node} ({kind.value}) stopped, no file written: {error}") from None
-        reporter.step()
     return values, skipped
+
+
+def _wait_all(futures: list[Future], reporter: _Reporter) -> None:
+    """Wait once for all transfers, counting progress as they complete.
+
+    Waiting on each future in turn would wake this thread once per object, competing with the bus reader for
+    the interpreter on every answer; here only the reader thread runs until the last answer.
+    """
+    for future in futures:
+        future.add_done_callback(reporter.step_done)
+    wait(futures)
 
 
 def _file_value(value: ObjectValue) -> int | str:
@@ -258,7 +273,7 @@ def restore_file(drive: Drive, path: Path, kind: FileKind | None = None, progres
         if kind is FileKind.SEQUENCE:
             result.outcomes = _write_sequences(drive, table, writes, progress)
         else:
-            result.outcomes = _write_and_verify(drive, writes, kind, progress)
+            _write_and_verify(drive, writes, kind, progress, result.outcomes)
         if store and all(outcome.status == "verified" for outcome in result.outcomes):
             procedure = "save_sequences" if kind is FileKind.SEQUENCE else "save"
             drive.start_procedure(procedure, timeout=SAVE_TIMEOUT)
@@ -278,13 +293,20 @@ def _check_can_store(drive: Drive, store: bool) -> None:
 
 
 def _write_and_verify(drive: Drive, writes: list[tuple[Variable, object]], kind: FileKind,
-                      progress: Progress | None) -> list[ObjectOutcome]:
-    """Write all, read all back; rewrite what a later write changed (side effects), read back once more."""
-    outcomes = {index: ObjectOutcome(var.label, _shown(value), "not written") for index, (var, value) in enumerate(writes)}
+                      progress: Progress | None, report: list[ObjectOutcome]) -> None:
+    """Write all, read all back; rewrite what a later write changed (side effects), read back once more.
+
+    ``report`` receives one outcome per object up front and is updated as answers arrive, so after a failure it
+    says exactly which objects were written.
+    """
+    outcomes = {index: ObjectOutcome(var.label, _shown(value), "not written")
+                for index, (var, value) in enumerate(writes)}
+    report.extend(outcomes.values())
     reporter = _Reporter(progress, "restore", drive.node, kind.value, 2 * len(writes))
     pending = list(range(len(writes)))
-    for attempt in range(2):
+    for _ in range(2):  # one rewrite pass for values that a later write changed
         write_futures = [(index, drive.submit_write(writes[index][0], writes[index][1])) for index in pending]
+        _wait_all([future for _, future in write_futures], reporter)
         link_error: SdoError | None = None
         for index, future in write_futures:
             try:
@@ -294,13 +316,13 @@ def _write_and_verify(drive: Drive, writes: list[tuple[Variable, object]], kind:
                 outcomes[index].status, outcomes[index].error = "failed", error.reason
             except SdoError as error:
                 link_error = link_error or error
-            reporter.step()
         if link_error is not None:
             raise_with = _partial(drive, outcomes, link_error)
             raise raise_with
         readable = [index for index in pending if outcomes[index].status == "written"
                     and writes[index][0].access.readable]
         read_futures = [(index, drive.submit_read(writes[index][0])) for index in readable]
+        _wait_all([future for _, future in read_futures], reporter)
         mismatched = []
         for index, future in read_futures:
             try:
@@ -315,14 +337,12 @@ def _write_and_verify(drive: Drive, writes: list[tuple[Variable, object]], kind:
             else:
                 outcomes[index].status, outcomes[index].error = "failed", f"read back {_shown(value)}"
                 mismatched.append(index)
-            reporter.step()
         for index in pending:
             if outcomes[index].status == "written":  # write-only objects cannot be read back
                 outcomes[index].status = "verified"
         pending = mismatched
         if not pending:
             break
-    return [outcomes[index] for index in range(len(writes))]
 
 
 def _partial(drive: Drive, outcomes: dict[int, ObjectOutcome], error: SdoError) -> BackupError:
@@ -393,19 +413,20 @@ def _write_sequences(drive: Drive, table: SequenceTable, writes: list[tuple[Vari
     """Write the whole sequence memory (LOAD semantics), then read it back and compare sequence by sequence."""
     futures = [drive.submit_write(variable, value) for variable, value in writes]
     reporter = _Reporter(progress, "restore", drive.node, FileKind.SEQUENCE.value, len(futures))
+    _wait_all(futures, reporter)
     for future in futures:
         try:
             future.result()
         except SdoAbortError as error:
             raise BackupError(f"node {drive.node}: sequence memory refused a write: {error}") from None
-        reporter.step()
     memory = _read_sequences(drive, None)
     outcomes = []
     for number in sorted(set(table) | set(memory)):
         wanted, found = table.sequences.get(number), memory.sequences.get(number)
         status = "verified" if wanted == found else "failed"
+        held = found.type.name if found else "empty"
         outcomes.append(ObjectOutcome(f"sequence {number}", wanted.type.name if wanted else "empty", status,
-                                      "" if status == "verified" else f"drive holds {found.type.name if found else 'empty'}"))
+                                      "" if status == "verified" else f"drive holds {held}"))
     return outcomes
 
 
@@ -417,12 +438,21 @@ class _Reporter:
         self.progress, self.operation, self.node, self.file, self.total = progress, operation, node, file, total
         self.done = 0
         self.every = max(1, total // _PROGRESS_STEPS)
+        self._lock = threading.Lock()
         self._emit()
 
     def step(self) -> None:
-        self.done += 1
-        if self.done % self.every == 0 or self.done == self.total:
+        with self._lock:  # done-callbacks run in the reader thread, or here when a future was already done
+            if self.done >= self.total:  # a rewrite pass of the restore is not counted again
+                return
+            self.done += 1
+            report = self.done % self.every == 0 or self.done == self.total
+        if report:
             self._emit()
+
+    def step_done(self, future: Future) -> None:
+        """Done-callback of a transfer (runs in the bus reader thread, which completes the transfers in order)."""
+        self.step()
 
     def finish(self) -> None:
         self.done = self.total

@@ -9,6 +9,7 @@ the drive behaviour gives objects side effects (`on_write`) or computed values (
 from __future__ import annotations
 
 from collections.abc import Callable, Iterable
+from functools import partial
 
 from servostudio.od.datatypes import DataType, EncodingError, decode, encode
 from servostudio.od.model import ObjectDictionary, Value, Variable
@@ -55,6 +56,17 @@ class ObjectStore:
 
     def get(self, index: int, sub: int = 0) -> Value:
         return self._values[(index, sub)]
+
+    def values_by_name(self, addresses: dict[str, tuple[int, int]]) -> dict[str, Value]:
+        """Many stored values at once, keyed by the caller's names (the drive model's parameter snapshot)."""
+        values = self._values
+        return {name: values[address] for name, address in addresses.items()}
+
+    def reader(self, index: int, sub: int = 0) -> Callable[[], Value]:
+        """A getter of one object's stored value: `get` without a Python call, for the per-period path."""
+        if (index, sub) not in self._values:
+            raise KeyError(f"0x{index:04X},{sub} is not in the {self.od.device} dictionary")
+        return partial(self._values.__getitem__, (index, sub))
 
     def set(self, index: int, sub: int, value: Value) -> None:
         key = (index, sub)

@@ -76,6 +76,7 @@ class PdoEngine:
         self._emergency = emergency
         self.rpdos: list[Pdo] = []
         self.tpdos: list[Pdo] = []
+        self._event_tpdos: list[Pdo] = []
         self.active = False
         self._dirty = True
         self._register_hooks()
@@ -131,6 +132,9 @@ class PdoEngine:
         """Rebuild the PDO tables from the communication and mapping objects."""
         self.rpdos = self._read_pdos(RPDO_COMMUNICATION, RPDO_MAPPING, receive=True)
         self.tpdos = self._read_pdos(TPDO_COMMUNICATION, TPDO_MAPPING, receive=False)
+        counting = (TPDO_COUNT, 0) in self.store  # type 254 is TPDO_Count mode, not event-driven
+        self._event_tpdos = [pdo for pdo in self.tpdos
+                             if pdo.transmission_type == 255 or (pdo.transmission_type == 254 and not counting)]
         self._dirty = False
 
     def _read_pdos(self, communication: int, mapping: int, receive: bool) -> list[Pdo]:
@@ -247,9 +251,7 @@ class PdoEngine:
         if self._dirty:
             self.configure()
         now = self.clock.now
-        for pdo in self.tpdos:
-            if pdo.transmission_type < 254 or (pdo.transmission_type == 254 and (TPDO_COUNT, 0) in self.store):
-                continue
+        for pdo in self._event_tpdos:
             value = self._first_value(pdo)
             timer_due = pdo.event_time > 0 and now >= pdo.next_event
             if (value != pdo.last_first_value or timer_due) and now >= pdo.next_allowed:

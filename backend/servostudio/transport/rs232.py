@@ -29,6 +29,7 @@ SDO_REQUEST = 0x600
 SDO_RESPONSE = 0x580
 REDIRECT_OFFSET = 0x40
 MAX_SWITCH_NODE = 63  # node IDs set by the switches; n+64 is reserved for the redirected channel
+READ_SLICE = 0.02  # longest single wait on the port, seconds
 
 
 def host_to_link(cob_id: int, cable_node: int | None) -> int:
@@ -66,7 +67,11 @@ class RS232Bus(can.BusABC):
     def send(self, msg: can.Message, timeout: float | None = None) -> None:
         if msg.is_extended_id or msg.is_remote_frame or msg.is_error_frame or msg.is_fd:
             raise can.CanOperationError("the RS-232 link carries only standard 11-bit data frames")
-        frame = encode_frame(HOST_HEADER, host_to_link(msg.arbitration_id, self.cable_node), bytes(msg.data))
+        self.send_frame(msg.arbitration_id, bytes(msg.data))
+
+    def send_frame(self, cob_id: int, data: bytes) -> None:
+        """Send a standard data frame without building a python-can Message (the SDO engine's hot path)."""
+        frame = encode_frame(HOST_HEADER, host_to_link(cob_id, self.cable_node), data)
         try:
             self._port.write(frame)
         except (serial.SerialException, OSError) as error:
@@ -80,7 +85,10 @@ class RS232Bus(can.BusABC):
         return None, False
 
     def _read(self, timeout: float | None) -> None:
-        if self._port.timeout != timeout:
+        # python-can passes the time left, different on every call; changing a real port's timeout is a
+        # tcsetattr, so it is set only when it moves by more than a millisecond (python-can loops on None).
+        timeout = READ_SLICE if timeout is None else min(timeout, READ_SLICE)
+        if self._port.timeout is None or abs(self._port.timeout - timeout) > 1e-3:
             self._port.timeout = timeout
         try:
             chunk = self._port.read(self._decoder.bytes_wanted)

@@ -85,7 +85,3 @@ class FrameDecoder:
     def bytes_wanted(self) -> int:
         """How many more bytes complete the frame being received (a reader can ask for exactly that many)."""
         return FRAME_LENGTH - len(self._buffer) if self._buffer else FRAME_LENGTH
-
-    def reset(self) -> None:
-        """Forget a partial frame (after the link was reopened)."""
-        self._buffer.clear()

@@ -49,9 +49,12 @@ class SocketcandBus(can.BusABC):
     def send(self, msg: can.Message, timeout: float | None = None) -> None:
         if msg.is_remote_frame or msg.is_error_frame or msg.is_fd:
             raise can.CanOperationError("socketcand raw mode: only data frames are sent by this client")
-        identifier = f"{msg.arbitration_id:08X}" if msg.is_extended_id else f"{msg.arbitration_id:03X}"
-        data = " ".join(f"{byte:02X}" for byte in msg.data)
-        self._command(f"send {identifier} {len(msg.data)} {data}".rstrip())
+        self.send_frame(msg.arbitration_id, bytes(msg.data), msg.is_extended_id)
+
+    def send_frame(self, cob_id: int, data: bytes, extended: bool = False) -> None:
+        """Send a data frame without building a python-can Message (the SDO engine's hot path)."""
+        identifier = f"{cob_id:08X}" if extended else f"{cob_id:03X}"
+        self._command(f"send {identifier} {len(data)} {data.hex(' ').upper()}".rstrip())
 
     def _recv_internal(self, timeout: float | None) -> tuple[can.Message | None, bool]:
         if not self._frames:

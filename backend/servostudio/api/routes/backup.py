@@ -10,7 +10,14 @@ from fastapi.responses import PlainTextResponse
 
 from servostudio.api.deps import current_user, get_connections, get_jobs
 from servostudio.api.routes.comm_models import BackupRequest, JobModel, RestoreRequest
-from servostudio.services.backup import FileKind, backup_drive, backup_file, drive_file_kinds, restore_file, run_per_drive
+from servostudio.services.backup import (
+    FileKind,
+    backup_drive,
+    backup_file,
+    drive_file_kinds,
+    restore_file,
+    run_per_drive,
+)
 from servostudio.services.bus import BusConnection, ConnectionManager, JobRegistry
 
 router = APIRouter(tags=["backup"], dependencies=[Depends(current_user)])
@@ -55,16 +62,13 @@ def start_restore(bus: str, request: RestoreRequest, manager: ConnectionManager 
     connection = manager.get(bus)
     nodes, kinds, directory = _nodes(connection, request.nodes), _kinds(request.files), Path(request.directory)
 
-    def restore_one(drive):
-        folder = directory / f"node{drive.node}"
-        chosen = kinds or [kind for kind in drive_file_kinds(drive) if (folder / kind.value).is_file()]
-        return [restore_file(drive, folder / kind.value, kind, lambda event: progress_ref[0]({**event, "bus": bus}),
-                             request.store) for kind in chosen]
-
-    progress_ref: list = [lambda event: None]
-
     def work(progress) -> dict:
-        progress_ref[0] = progress
+        def restore_one(drive):
+            folder = directory / f"node{drive.node}"
+            chosen = kinds or [kind for kind in drive_file_kinds(drive) if (folder / kind.value).is_file()]
+            return [restore_file(drive, folder / kind.value, kind, lambda event: progress({**event, "bus": bus}),
+                                 request.store) for kind in chosen]
+
         return _per_node(run_per_drive([connection.drive(node) for node in nodes], restore_one))
 
     return jobs.start("restore", work).as_dict()

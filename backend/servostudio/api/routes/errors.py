@@ -5,7 +5,8 @@ from __future__ import annotations
 from fastapi import FastAPI, Request
 from fastapi.responses import JSONResponse
 
-from servostudio.drive.access import DriveAccessError
+from servostudio.drive.access import DriveAccessError, UnknownObjectError
+from servostudio.drive.control import StateChangeError
 from servostudio.drive.link import LinkDownError
 from servostudio.drive.profiles import ProfileError
 from servostudio.drive.sdo import SdoAbortError, SdoError, SdoLinkError, SdoTimeoutError
@@ -18,16 +19,19 @@ from servostudio.transport.spec import BusSpecError
 STATUS = [
     (UnknownBusOrNode, 404),
     (ProfileError, 404),
+    (UnknownObjectError, 404),
     (RestoreValidationError, 422),
     (DriveAccessError, 422),
     (BusSpecError, 422),
     (TerminalError, 422),
     (SdoAbortError, 409),
+    (StateChangeError, 409),
     (SdoTimeoutError, 504),
     (SdoLinkError, 503),
     (LinkDownError, 503),
     (SdoError, 502),
     (BackupError, 502),
+    (ValueError, 422),  # any other refused input (NMT command, state name, …)
 ]
 
 

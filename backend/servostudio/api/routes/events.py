@@ -37,7 +37,7 @@ async def events_socket(socket: WebSocket, types: str | None = None, user: User 
                 await socket.send_json(getter.result())
             else:
                 getter.cancel()
-    except WebSocketDisconnect:
+    except (WebSocketDisconnect, RuntimeError):  # RuntimeError: sending after the client closed
         pass
     finally:
         subscription.close()
@@ -72,7 +72,8 @@ async def terminal_socket(socket: WebSocket, user: User = Depends(current_user),
                         monitor.cancel()
                         monitor = None
                     if operation == "read":
-                        await socket.send_json({"type": "values", "rows": await asyncio.to_thread(sample, manager, watch)})
+                        rows = await asyncio.to_thread(sample, manager, watch)
+                        await socket.send_json({"type": "values", "rows": rows})
                     elif watch.items:
                         monitor = asyncio.create_task(_monitor(socket, manager, watch))
                 else:
@@ -89,7 +90,8 @@ async def terminal_socket(socket: WebSocket, user: User = Depends(current_user),
 
 
 def _watch(message: dict) -> Watch:
-    items = tuple(WatchItem(str(item["bus"]), int(item["node"]), str(item["object"])) for item in message.get("items", []))
+    items = tuple(WatchItem(str(item["bus"]), int(item["node"]), str(item["object"]))
+                  for item in message.get("items", []))
     return Watch(items, float(message.get("period_ms", 200)) / 1000)
 
 

@@ -23,7 +23,8 @@ _EMCY = {info.cia402_code: info for info in (
     FaultInfo(0, 0x8200, "Protocol error", ""),
     FaultInfo(0, 0x8210, "PDO ignored (length error)", ""),
     FaultInfo(0, 0x8220, "PDO length exceeded", ""),
-    FaultInfo(0, 0x8611, "Following error", "The error exceeded 0x6065 for longer than 0x6066; check the supply voltage "
+    FaultInfo(0, 0x8611, "Following error", "The error exceeded 0x6065 for longer than 0x6066; check the supply "
+              "voltage "
               "and the load."),
 )}
 

@@ -11,8 +11,10 @@ from servostudio.drive.faults import FaultInfo
 
 _EMC = ("Check that the DNC/PLC-amplifier-motor ground connections and shield answer the Installation manual "
         "requirements. Check the application EMC disturbances level.")
-_REPHASE = " In the incremental encoder configuration without HES, execute the motor phasing procedure again after the fault is released."
-_POWER_CYCLE = "Switch the 24 V logic supply off and on again. If the error cannot be reset, the amplifier is out of order."
+_REPHASE = (" In the incremental encoder configuration without HES, execute the motor phasing procedure again after "
+            "the fault is released.")
+_POWER_CYCLE = ("Switch the 24 V logic supply off and on again. If the error cannot be reset, the amplifier is out "
+                "of order.")
 
 ERRORS: dict[int, FaultInfo] = {info.code: info for info in (
     FaultInfo(1, 0x5080, "Hardware System 2 error", _EMC),
@@ -116,7 +118,8 @@ ERRORS: dict[int, FaultInfo] = {info.code: info for info in (
     FaultInfo(61, 0x7305, "Encoder 1 commutation channel / incremental channel error", "Incremental encoder + HES: "
               "check the HES supply and wiring, toggle Reverse HES track if wrong, check Motor encoder resolution. "
               "Hiperface: toggle Reverse incremental track if wrong, check the SinCos and data channel wiring. "
-              "SinCos with CD tracks: check the supply, the CD channel wiring and waveforms, toggle Reverse CD track if "
+              "SinCos with CD tracks: check the supply, the CD channel wiring and waveforms, toggle Reverse CD track "
+              "if "
               "wrong, check Motor encoder resolution. In every case check grounding and shielding."),
     FaultInfo(62, 0x7305, "Encoder 1 absolute channel error", "Check the encoder supply voltage, the data channel "
               "wiring, and the grounding and shielding of the encoder cable."),

@@ -66,10 +66,15 @@ class BusConnection:
     monitor: BusMonitor | None = None
 
     def drive(self, node: int, device: str | None = None) -> Drive:
-        """Drive access for a node: the device found by the scan, else ``device``, else the only known device."""
+        """Drive access for a node: ``device`` if given, else the device a scan found (a node not scanned yet is
+        identified now; one that does not answer gets a Drive without dictionary, which refuses typed access)."""
         if not 1 <= node <= 127:
             raise UnknownBusOrNode(f"node ID {node} outside 1..127")
         info = self.nodes.get(node)
+        if info is None and device is None and self.link.connected:
+            from servostudio.services.scan import identify  # scan builds on this module
+
+            info = identify(self, node)
         device = device or (info.device if info else None)
         dictionary = self.library.load(device) if device else None
         return Drive(self.engine, node, dictionary, profile_for(device))

@@ -1,11 +1,13 @@
 """Projects and axes: the project store, offline parameter editing, compare, motor catalog, Device Config templates,
-archives and DCF export. See docs/projects.md."""
+archives and DCF export; with live drives in the subpackage ``live``. See docs/projects.md."""
 
 from servostudio.services.projects.archive import ArchiveLimits
 from servostudio.services.projects.compare import CompareRow, DefaultValues, ParameterSource, ProjectValues, compare
 from servostudio.services.projects.errors import (
     ArchiveError,
     ConflictError,
+    DriveMismatch,
+    DriveUnavailable,
     FileFormatError,
     InvalidName,
     ParameterRefused,
@@ -22,9 +24,9 @@ from servostudio.services.projects.store import ProjectStore, Snapshot
 from servostudio.services.projects.templates import TEMPLATES, ApplicationTemplate, templates_for
 
 __all__ = [
-    "TEMPLATES", "ApplicationTemplate", "ArchiveError", "ArchiveLimits", "Axis", "AxisChoice", "Bus", "CompareRow",
-    "ConflictError", "DefaultValues", "FileFormatError", "InvalidName", "Motor", "MotorCatalog", "ParameterChange",
-    "ParameterRefused", "ParameterRow", "ParameterService", "ParameterSource", "Project", "ProjectError",
-    "ProjectExists", "ProjectNotFound", "ProjectService", "ProjectStore", "ProjectValues", "Snapshot",
-    "ValidationError", "compare", "templates_for",
+    "ApplicationTemplate", "ArchiveError", "ArchiveLimits", "Axis", "AxisChoice", "Bus", "CompareRow",
+    "ConflictError", "DefaultValues", "DriveMismatch", "DriveUnavailable", "FileFormatError", "InvalidName", "Motor",
+    "MotorCatalog", "ParameterChange", "ParameterRefused", "ParameterRow", "ParameterService", "ParameterSource",
+    "Project", "ProjectError", "ProjectExists", "ProjectNotFound", "ProjectService", "ProjectStore", "ProjectValues",
+    "Snapshot", "TEMPLATES", "ValidationError", "compare", "templates_for",
 ]

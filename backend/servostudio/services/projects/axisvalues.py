@@ -70,6 +70,12 @@ class AxisValues:
     def editable_reason(self, variable: Variable) -> str | None:
         return editable_reason(variable, self.parameter_files)
 
+    def transferable(self) -> list[Variable]:
+        """The objects a drive and the project exchange (download writes them, upload reads them): editable offline
+        and readable from the drive, in dictionary order."""
+        return [variable for variable in self.dictionary.variables()
+                if variable.access.readable and self.editable_reason(variable) is None]
+
     # ---- reading ---------------------------------------------------------------------------------------------
 
     def explicit(self, variable: Variable) -> Value | None:

@@ -57,3 +57,11 @@ class FileFormatError(ProjectError):
 
 class ArchiveError(ProjectError):
     """An archive cannot be unpacked safely (path traversal, link, oversized member, zip bomb, not a zip)."""
+
+
+class DriveMismatch(ProjectError):
+    """The drive found at an axis's bus and node is not the device the project expects (or not identifiable)."""
+
+
+class DriveUnavailable(ProjectError):
+    """An axis's drive cannot be reached: its bus is not connected or the node does not answer."""

@@ -104,7 +104,9 @@ class ParameterService:
 
     def compare(self, project: str, axis: str, *, group: str | None = None, only_differences: bool = False,
                 drive: ParameterSource | None = None) -> tuple[list[CompareRow], str]:
-        """Columns drive (when given) / project / default for every saved object of the axis."""
+        """Columns project / default for every saved object of the axis; with a ``drive``, columns drive / project /
+        default for the objects drive and project exchange (:meth:`AxisValues.transferable`), and a row differs
+        when the drive's value is not the project's."""
         with self.store.read(project) as view:
             values = self._load(view, axis)
             sources: dict[str, ParameterSource] = {}
@@ -112,8 +114,19 @@ class ParameterService:
                 sources["drive"] = drive
             sources["project"] = ProjectValues(values)
             sources["default"] = DefaultValues(values.dictionary, values.node_id)
-            saved = (v for v in values.dictionary.variables() if v.save_type is not SaveType.NONE)
-            return compare(sources, saved, group=group, only_differences=only_differences), view.revision
+            if drive is None:
+                chosen = [v for v in values.dictionary.variables() if v.save_type is not SaveType.NONE]
+            else:
+                chosen = values.transferable()
+            rows = compare(sources, chosen, group=group, only_differences=only_differences,
+                           between=("drive", "project") if drive is not None else None)
+            return rows, view.revision
+
+    def transferable(self, project: str, axis: str, group: str | None = None) -> list[Variable]:
+        """The objects a compare with the drive covers (optionally one UI group): what a drive source must read."""
+        with self.store.read(project) as view:
+            variables = self._load(view, axis).transferable()
+        return [v for v in variables if group is None or v.group.casefold() == group.casefold()]
 
     def axis_values(self, edit: ProjectEdit, axis: str) -> AxisValues:
         """The parsed value files of an axis inside an edit (for motor selection, templates, DCF export)."""

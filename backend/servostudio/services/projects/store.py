@@ -154,17 +154,26 @@ class ProjectStore:
     # ---- axes -----------------------------------------------------------------------------------------------
 
     def add_axis(self, name: str, axis: Axis, expected_revision: str | None = None) -> Snapshot:
+        return self.add_axes(name, (axis,), expected_revision)
+
+    def add_axes(self, name: str, axes: tuple[Axis, ...], expected_revision: str | None = None,
+                 buses: tuple[Bus, ...] = ()) -> Snapshot:
+        """Add buses and axes in one change (a scan adds its findings together): all are validated first; an axis
+        directory is built in a staging directory and renamed into place before the project file names it."""
         with self.edit(name, expected_revision) as edit:
-            project = edit.project.with_axes((*edit.project.axes, axis))
+            project = replace(edit.project, buses=(*edit.project.buses, *buses),
+                              axes=(*edit.project.axes, *axes))
             self._validate(project)
-            directory = edit.directory / axis.name
-            if directory.exists():
-                raise ProjectExists(f"'{directory}' already exists but is not an axis of project '{name}';"
-                                    " move it away or choose another axis name")
-            with self.staging(edit.directory) as staging:
-                for file_name in axis_files(axis.device):
-                    atomic_write(staging / file_name, "")
-                os.rename(staging, directory)
+            for axis in axes:
+                directory = edit.directory / axis.name
+                if directory.exists():
+                    raise ProjectExists(f"'{directory}' already exists but is not an axis of project '{name}';"
+                                        " move it away or choose another axis name")
+            for axis in axes:
+                with self.staging(edit.directory) as staging:
+                    for file_name in axis_files(axis.device):
+                        atomic_write(staging / file_name, "")
+                    os.rename(staging, edit.directory / axis.name)
             edit.save(project)
         return Snapshot(edit.project, edit.revision)
 

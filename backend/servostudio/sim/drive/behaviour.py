@@ -10,6 +10,7 @@ protections, inputs and the status word run every 1 ms; measurements are compute
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from typing import Any, Protocol
 
 from servostudio.sim.clock import CONTROL_PERIOD
@@ -25,6 +26,7 @@ from servostudio.sim.drive.loops import (
     time_constant_alpha,
 )
 from servostudio.sim.drive.modes import (
+    BIT_TARGET_REACHED,
     CW_HALT,
     U32_OFF,
     HomingMode,
@@ -65,7 +67,7 @@ STANDSTILL_SPEED = 0.5  # rad/s: a stop has ended below this speed
 
 
 _STOPPING = Phase.STOPPING
-_MOVING_STATES = (State.OPERATION_ENABLED, State.QUICK_STOP_ACTIVE)
+_IDLE = Phase.IDLE
 
 
 class Events(Protocol):
@@ -101,6 +103,7 @@ class DriveBehaviour:
         }
         self.active_mode = 0
         self.control_word = 0
+        self.halted = False  # control word bit 8 on a device that has the halt bit
         self.active_errors: dict[int, DriveError] = {}
         self.warnings = 0
         self.following_error_active = False
@@ -114,10 +117,9 @@ class DriveBehaviour:
         self.max_current = 1.0
         self.drive_max_current = 1.0
         self._addresses = {name: addr for name, addr in profile.objects.items() if addr in store}
-        self._control_word_address = profile.objects["control_word"]
+        self._read_control_word = store.reader(*profile.objects["control_word"])
         self._active_handler: ModeHandler | None = None
         self._linked_bits = 0
-        self._pointers: dict[int, tuple[int, int]] = {}
         self.p: dict[str, Any] = {}
         self.snapshot()
         self._stop_options = StopOptions()
@@ -166,19 +168,19 @@ class DriveBehaviour:
         return default if address is None else self.store.get(*address)
 
     def snapshot(self) -> None:
-        get = self.store.get
-        self.p = {name: get(*address) for name, address in self._addresses.items()}
+        self.p = self.store.values_by_name(self._addresses)
 
-    def read_pointer(self, source_name: str, default_name: str) -> float:
-        """A "dataflow" source object (index<<16 | sub<<8): read what it points to, else the default object."""
+    def pointer_reader(self, source_name: str, default_name: str) -> Callable[[], float]:
+        """A reader of a "dataflow" source object (index<<16 | sub<<8): what it points to, else the default
+        object. Valid until the next parameter snapshot (mode handlers take one in `configure`)."""
         pointer = self.p.get(source_name, 0)
         if pointer:
-            address = self._pointers.get(pointer)
-            if address is None:
-                address = self._pointers[pointer] = ((pointer >> 16) & 0xFFFF, (pointer >> 8) & 0xFF)
+            address = ((pointer >> 16) & 0xFFFF, (pointer >> 8) & 0xFF)
             if address in self.store:
-                return float(self.store.get(*address))
-        return float(self.p.get(default_name, 0))
+                read = self.store.reader(*address)
+                return lambda: float(read())
+        parameters = self.p
+        return lambda: float(parameters.get(default_name, 0))
 
     # -- hooks --------------------------------------------------------------------------------------------------
 
@@ -391,6 +393,7 @@ class DriveBehaviour:
             self.phasing_valid = False
         self.position_offset_user = 0.0
         self.control_word = 0
+        self.halted = False
         self.active_mode = 0
         self._active_handler = None
         if self.commissioned:
@@ -407,14 +410,15 @@ class DriveBehaviour:
         periods = self._periods = self._periods + 1
         if self._dirty or periods % PARAMETER_REFRESH_PERIODS == 0:
             self.refresh_parameters()
-        control_word = self.store.get(*self._control_word_address)
+        control_word = self._read_control_word()
         if control_word != self.control_word:
             self._on_control_word(control_word)
             self._supervise()
         elif periods % SUPERVISION_PERIODS == 0:
             self._supervise()
         device_control = self.device_control
-        device_control.step(self.dt)
+        if device_control.phase is not _IDLE:  # enable and brake timers
+            device_control.step(self.dt)
         if device_control.state is not self._published_state:
             self._publish_fast()
         loops = self.loops
@@ -442,11 +446,12 @@ class DriveBehaviour:
     def _on_control_word(self, control_word: int) -> None:
         previous = self.control_word
         self.control_word = control_word
+        self.halted = self.profile.halt_bit and bool(control_word & CW_HALT)
         if control_word & CW_FAULT_RESET and not previous & CW_FAULT_RESET:
             self._fault_reset()
         was_following = self.device_control.follows_set_points
         self.device_control.command(decode_command(control_word), self._stop_options, self._can_enable())
-        handler = self._handler()
+        handler = self._active_handler
         if handler is not None:
             if self.device_control.follows_set_points and not was_following:
                 handler.enter()
@@ -454,13 +459,6 @@ class DriveBehaviour:
 
     def _can_enable(self) -> bool:
         return self.phasing_valid and self.procedures.active is None and not self.inhibit_active
-
-    def _handler(self) -> ModeHandler | None:
-        return self._active_handler
-
-    @property
-    def halted(self) -> bool:
-        return self.profile.halt_bit and bool(self.control_word & CW_HALT)
 
     def _run_loops_for_state(self) -> None:
         device_control = self.device_control
@@ -474,13 +472,13 @@ class DriveBehaviour:
         if loops.mode == MODE_OFF:
             loops.reset_integrators()
             self._hold_position = loops.position
-            handler = self._handler()
+            handler = self._active_handler
             if handler is not None:
                 handler.enter()
         if device_control.phase is _STOPPING:
             self._run_stop()
-        elif device_control.follows_set_points and self._handler() is not None:
-            self._handler().step()
+        elif device_control.follows_set_points and self._active_handler is not None:
+            self._active_handler.step()
             self._block_at_limits()
             if loops.mode == MODE_POSITION:
                 self._hold_position = loops.position_ref
@@ -497,7 +495,7 @@ class DriveBehaviour:
         if self.active_mode == MODE_HM or loops.mode != MODE_POSITION:
             return
         if self.limit_blocks(loops.velocity_ff):
-            handler = self._handler()
+            handler = self._active_handler
             if isinstance(handler, ProfilePosition):
                 handler.limit_switch_stop()
             loops.position_ref = loops.position
@@ -840,8 +838,15 @@ class DriveBehaviour:
             status |= WARNING
         if self.procedures.active is not None or getattr(self.events, "flash_busy", False):
             status |= BUSY
-        handler = self._handler()
-        if device_control.state in _MOVING_STATES and handler is not None:
+        handler = self._active_handler
+        if device_control.state is State.QUICK_STOP_ACTIVE:
+            # CiA 402: in Quick Stop Active bit 10 means "the quick stop has ended, the axis stands still"; the
+            # mode's own target is not being followed
+            if handler is not None:
+                status |= handler.status_bits() & ~BIT_TARGET_REACHED
+            if device_control.phase is not _STOPPING:
+                status |= BIT_TARGET_REACHED
+        elif device_control.state is State.OPERATION_ENABLED and handler is not None:
             status |= handler.status_bits()
         elif isinstance(handler, HomingMode):
             status |= handler.status_bits() & (1 << 13)

@@ -92,33 +92,49 @@ class ServoLoops:
         self.position = position
         self.speed += self.speed_alpha * (self.speed_raw - self.speed)
 
-    def commutation_angle(self) -> float:
-        if self.mode == MODE_FORCED_VECTOR:
-            return self.forced_angle
-        return TWO_PI * (self.pole_pairs * self.position / TWO_PI + self.offset_turns)
-
     def step(self) -> None:
-        """Run the loops for the current mode and apply the voltages to the physics for one period."""
+        """Run the loops for the current mode and apply the voltages to the physics for one period.
+
+        The commutation angle and the current PI are written out here rather than called: this runs 4000 times
+        per simulated second per axis."""
         physics = self.physics
         mode = self.mode
+        phase_sign = self.phase_sign
         if mode == MODE_OFF:
             self.current_demand = 0.0
             self.i_d = self.i_q = 0.0
-            physics.step(0.0, 0.0, 0.0, self.phase_sign)
+            physics.step(0.0, 0.0, 0.0, phase_sign)
             return
-        theta = self.commutation_angle()
         if mode == MODE_FORCED_VECTOR:
+            theta = self.forced_angle
             id_ref = self.forced_current
             iq_ref = 0.0
         else:
+            theta = TWO_PI * (self.pole_pairs * self.position / TWO_PI + self.offset_turns)
             iq_ref = self._current_reference(mode)
             id_ref = 0.0
         self.current_demand = iq_ref
-        i_d, i_q = physics.measured_currents(theta, self.phase_sign)
+        i_d, i_q = physics.measured_currents(theta, phase_sign)
         self.i_d = i_d
         self.i_q = i_q
-        v_d, v_q = self._current_loop(id_ref - i_d, iq_ref - i_q)
-        physics.step(v_d, v_q, theta, self.phase_sign)
+        # current PI with back-EMF feed-forward, voltage limited to Vdc/√3 (no integration while limited)
+        error_d = id_ref - i_d
+        error_q = iq_ref - i_q
+        dt = self.dt
+        vi_d = self._vi_d + self.ki_d * error_d * dt
+        vi_q = self._vi_q + self.ki_q * error_q * dt
+        v_d = self.kp_d * error_d + vi_d
+        v_q = self.kp_q * error_q + vi_q + self.emf_constant * self.speed
+        v_max = physics.dc_bus / 1.7320508075688772
+        magnitude = math.sqrt(v_d * v_d + v_q * v_q)
+        if magnitude > v_max:
+            scale = v_max / magnitude
+            v_d *= scale
+            v_q *= scale
+        else:
+            self._vi_d = vi_d
+            self._vi_q = vi_q
+        physics.step(v_d, v_q, theta, phase_sign)
 
     def _current_reference(self, mode: int) -> float:
         speed = self.speed
@@ -158,23 +174,6 @@ class ServoLoops:
             states[n] += alpha * (demand - states[n])
             demand = states[n]
         return demand
-
-    def _current_loop(self, error_d: float, error_q: float) -> tuple[float, float]:
-        dt = self.dt
-        vi_d = self._vi_d + self.ki_d * error_d * dt
-        vi_q = self._vi_q + self.ki_q * error_q * dt
-        v_d = self.kp_d * error_d + vi_d
-        v_q = self.kp_q * error_q + vi_q + self.emf_constant * self.speed
-        v_max = self.physics.dc_bus / 1.7320508075688772
-        magnitude = math.sqrt(v_d * v_d + v_q * v_q)
-        if magnitude > v_max:
-            scale = v_max / magnitude
-            v_d *= scale
-            v_q *= scale
-        else:
-            self._vi_d = vi_d
-            self._vi_q = vi_q
-        return v_d, v_q
 
 
 def low_pass_alpha(cutoff_hz: float, dt: float) -> float:

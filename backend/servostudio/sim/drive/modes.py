@@ -7,6 +7,7 @@ Each handler is asked, once per control period while the drive follows set-point
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from typing import TYPE_CHECKING
 
 from servostudio.sim.drive import errors
@@ -163,6 +164,8 @@ class ProfileVelocity(ModeHandler):
         self.standstill = False
         self._timer_time = 0.0
         self.limit = math.inf
+        self.speed_unit = 1.0
+        self.read_target: Callable[[], float] = lambda: 0.0
         self.accel = self.decel = 1.0
 
     def enter(self) -> None:
@@ -176,12 +179,14 @@ class ProfileVelocity(ModeHandler):
         units = drive.units
         limit_user = float(drive.p.get("max_profile_velocity", 0))
         self.limit = min(drive.max_speed, units.speed_to_rad(limit_user) if limit_user > 0 else math.inf)
+        self.speed_unit = units.speed_to_rad(1.0)  # rad/s per user unit/s, for the per-period conversion
+        self.read_target = drive.pointer_reader("target_velocity_source", "target_velocity")
         self.accel = units.accel_to_rad(float(drive.p.get("profile_acceleration", 0)))
         self.decel = units.accel_to_rad(float(drive.p.get("profile_deceleration", 0)))
 
     def step(self) -> None:
         drive = self.drive
-        target = drive.units.speed_to_rad(drive.read_pointer("target_velocity_source", "target_velocity"))
+        target = self.read_target() * self.speed_unit
         limit = self.limit
         if target > limit:
             target = limit
@@ -233,6 +238,10 @@ class ProfileTorque(ModeHandler):
         super().__init__(drive)
         self.current = 0.0
         self.target = 0.0
+        self.read_target: Callable[[], float] = lambda: 0.0
+
+    def configure(self) -> None:
+        self.read_target = self.drive.pointer_reader("target_torque_source", "target_torque")
 
     def enter(self) -> None:
         self.current = 0.0
@@ -240,7 +249,7 @@ class ProfileTorque(ModeHandler):
     def step(self) -> None:
         drive = self.drive
         rated = drive.rated_current
-        target = float(drive.read_pointer("target_torque_source", "target_torque")) / 1000.0 * rated
+        target = self.read_target() / 1000.0 * rated
         if drive.halted or drive.limit_blocks(target):
             target = 0.0
         self.target = target

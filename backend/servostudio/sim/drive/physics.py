@@ -48,6 +48,11 @@ class AxisPhysics:
         self.braking_power = 0.0
         self.stopped_at_hard_stop = False
         self._inductance = plant.inductance / 2.0  # phase inductance from the phase-to-phase value
+        self._inductance_pole_pairs = self._inductance * plant.pole_pairs
+        self._rigid_inertia = plant.motor_inertia + plant.load_inertia
+        self._copper_factor = 1.5 * plant.phase_resistance
+        self._negative_stop = None if plant.negative_hard_stop is None else plant.negative_hard_stop * TWO_PI
+        self._positive_stop = None if plant.positive_hard_stop is None else plant.positive_hard_stop * TWO_PI
         self._decay = math.exp(-plant.phase_resistance * dt / self._inductance)
         self._gain = (1.0 - self._decay) / plant.phase_resistance
         self._bus_decay = math.exp(-dt / (plant.supply_resistance * plant.dc_bus_capacitance))
@@ -71,7 +76,7 @@ class AxisPhysics:
 
     def sensor_counts(self) -> int:
         """Quantised multi-turn position counter of the motor sensor, relative to its power-on zero."""
-        return math.floor(self.motor_turns * self._counts) - self._counter_zero
+        return math.floor(self.theta_motor / TWO_PI * self._counts) - self._counter_zero
 
     def counter_turns(self, true_turns: float) -> float:
         """A true shaft position (turns) in the sensor counter's coordinates (unquantised)."""
@@ -114,7 +119,10 @@ class AxisPhysics:
         return c * i_d + sn * i_q, s * (-sn * i_d + c * i_q)
 
     def step(self, v_d_hat: float, v_q_hat: float, theta_hat: float, phase_sign: int) -> None:
-        """Apply the drive-frame voltages for one period and advance everything."""
+        """Apply the drive-frame voltages for one period and advance everything.
+
+        The rigid mechanics, the DC bus, the heat and the index pulse are written out here rather than called:
+        this runs 4000 times per simulated second per axis."""
         plant = self.plant
         dt = self.dt
         if self.power_stage_on:
@@ -127,89 +135,54 @@ class AxisPhysics:
             v_d = c * v_d_hat - sn * vq_m
             v_q = sn * v_d_hat + c * vq_m
             omega = self.omega_motor
-            lw = self._inductance * plant.pole_pairs * omega
+            lw = self._inductance_pole_pairs * omega
             i_d = self.i_d
             i_q = self.i_q
             decay = self._decay
             gain = self._gain
-            self.i_d = decay * i_d + gain * (v_d + lw * i_q)
-            self.i_q = decay * i_q + gain * (v_q - lw * i_d - plant.torque_constant * omega / 1.5)
-            self.v_d = v_d
-            self.v_q = v_q
+            i_d, i_q = (decay * i_d + gain * (v_d + lw * i_q),
+                        decay * i_q + gain * (v_q - lw * i_d - plant.torque_constant * omega / 1.5))
         else:
-            self.i_d = 0.0
-            self.i_q = 0.0
-            self.v_d = 0.0
-            self.v_q = 0.0
+            i_d = i_q = v_d = v_q = 0.0
+        self.i_d = i_d
+        self.i_q = i_q
+        self.v_d = v_d
+        self.v_q = v_q
         self._frame = None
-        self._step_mechanics(plant.torque_constant * self.i_q, dt)
-        self._step_bus(dt)
-        copper = 1.5 * plant.phase_resistance * (self.i_d * self.i_d + self.i_q * self.i_q)
-        target = plant.ambient_temperature + plant.thermal_resistance * copper
-        self.temperature += (target - self.temperature) * dt / plant.thermal_time_constant
-        self._track_index()
-
-    def _step_mechanics(self, torque: float, dt: float) -> None:
-        plant = self.plant
+        torque = plant.torque_constant * i_q
         if plant.two_mass:
-            spring = plant.coupling_stiffness * (self.theta_motor - self.theta_load) + plant.coupling_damping * (
-                self.omega_motor - self.omega_load
-            )
-            self.omega_motor = self._brake(
-                self.omega_motor, torque - spring - plant.viscous_friction * 0.1 * self.omega_motor, plant.motor_inertia,
-                plant.coulomb_friction * 0.1, dt,
-            )
-            self.theta_motor += self.omega_motor * dt
-            self.omega_load = _coulomb_step(
-                self.omega_load, spring - plant.gravity_torque - plant.viscous_friction * 0.9 * self.omega_load,
-                plant.load_inertia, plant.coulomb_friction * 0.9, dt,
-            )
-            self.theta_load += self.omega_load * dt
-            self._hard_stops_load()
+            self._step_two_mass(torque, dt)
         else:
-            driving = torque - plant.gravity_torque - plant.viscous_friction * self.omega_motor
+            omega = self.omega_motor
+            driving = torque - plant.gravity_torque - plant.viscous_friction * omega
             friction = plant.coulomb_friction + (plant.brake_torque if self.brake_engaged else 0.0)
-            omega = _coulomb_step(self.omega_motor, driving, plant.motor_inertia + plant.load_inertia, friction, dt)
-            self.omega_motor = self.omega_load = omega
-            self.theta_motor += omega * dt
-            self.theta_load = self.theta_motor
-            self._hard_stops_rigid()
-
-    def _brake(self, omega: float, driving: float, inertia: float, friction: float, dt: float) -> float:
-        """An engaged holding brake adds its torque to the dry friction of the motor shaft."""
-        if self.brake_engaged:
-            friction += self.plant.brake_torque
-        return _coulomb_step(omega, driving, inertia, friction, dt)
-
-    def _hard_stops_rigid(self) -> None:
-        low, high = self.plant.negative_hard_stop, self.plant.positive_hard_stop
-        self.stopped_at_hard_stop = False
-        if low is not None and self.theta_motor <= low * TWO_PI and self.omega_motor <= 0.0:
-            self.theta_motor = self.theta_load = low * TWO_PI
-            self.omega_motor = self.omega_load = 0.0
-            self.stopped_at_hard_stop = True
-        elif high is not None and self.theta_motor >= high * TWO_PI and self.omega_motor >= 0.0:
-            self.theta_motor = self.theta_load = high * TWO_PI
-            self.omega_motor = self.omega_load = 0.0
-            self.stopped_at_hard_stop = True
-
-    def _hard_stops_load(self) -> None:
-        low, high = self.plant.negative_hard_stop, self.plant.positive_hard_stop
-        self.stopped_at_hard_stop = False
-        if low is not None and self.theta_load <= low * TWO_PI and self.omega_load <= 0.0:
-            self.theta_load = low * TWO_PI
-            self.omega_load = 0.0
-            self.stopped_at_hard_stop = True
-        elif high is not None and self.theta_load >= high * TWO_PI and self.omega_load >= 0.0:
-            self.theta_load = high * TWO_PI
-            self.omega_load = 0.0
-            self.stopped_at_hard_stop = True
-
-    def _step_bus(self, dt: float) -> None:
-        """Rectified mains through a source resistance into the bus capacitor, braking chopper above its threshold."""
-        plant = self.plant
+            if omega == 0.0:  # dry friction: the axis sticks while |driving torque| ≤ friction (see _coulomb_step)
+                if abs(driving) <= friction:
+                    new = 0.0
+                else:
+                    new = dt * (driving - math.copysign(friction, driving)) / self._rigid_inertia
+            else:
+                new = omega + dt * (driving - math.copysign(friction, omega)) / self._rigid_inertia
+                if (new > 0.0) != (omega > 0.0):
+                    new = 0.0
+            theta = self.theta_motor + new * dt
+            self.stopped_at_hard_stop = False
+            low = self._negative_stop
+            high = self._positive_stop
+            if low is not None and theta <= low and new <= 0.0:
+                theta = low
+                new = 0.0
+                self.stopped_at_hard_stop = True
+            elif high is not None and theta >= high and new >= 0.0:
+                theta = high
+                new = 0.0
+                self.stopped_at_hard_stop = True
+            self.omega_motor = self.omega_load = new
+            self.theta_motor = self.theta_load = theta
+        # DC bus: rectified mains through a source resistance into the capacitor, braking chopper above its
+        # threshold
         voltage = self.dc_bus
-        power = 1.5 * (self.v_d * self.i_d + self.v_q * self.i_q)
+        power = 1.5 * (v_d * i_d + v_q * i_q)
         load_current = power / voltage if voltage > 1.0 else 0.0
         settled = plant.dc_bus_voltage - plant.supply_resistance * load_current
         if self.mains_on and settled <= plant.dc_bus_voltage:
@@ -222,15 +195,51 @@ class AxisPhysics:
             self.braking_power = chopper * voltage
             voltage -= chopper * dt / plant.dc_bus_capacitance
         self.dc_bus = max(voltage, 0.0)
-
-    def _track_index(self) -> None:
-        """Latch the exact position of an index (zero) pulse crossed during this period."""
-        cycle = math.floor(self.motor_turns - self.plant.index_position)
+        copper = self._copper_factor * (i_d * i_d + i_q * i_q)
+        target = plant.ambient_temperature + plant.thermal_resistance * copper
+        self.temperature += (target - self.temperature) * dt / plant.thermal_time_constant
+        # index pulse: latch the exact position of one crossed during this period
+        cycle = math.floor(self.theta_motor / TWO_PI - plant.index_position)
         if cycle != self._index_cycle:
             boundary = max(cycle, self._index_cycle)
-            self.index_turns = boundary + self.plant.index_position
+            self.index_turns = boundary + plant.index_position
             self.index_seen = True
             self._index_cycle = cycle
+
+    def _step_two_mass(self, torque: float, dt: float) -> None:
+        plant = self.plant
+        spring = plant.coupling_stiffness * (self.theta_motor - self.theta_load) + plant.coupling_damping * (
+            self.omega_motor - self.omega_load
+        )
+        self.omega_motor = self._brake(
+            self.omega_motor, torque - spring - plant.viscous_friction * 0.1 * self.omega_motor, plant.motor_inertia,
+            plant.coulomb_friction * 0.1, dt,
+        )
+        self.theta_motor += self.omega_motor * dt
+        self.omega_load = _coulomb_step(
+            self.omega_load, spring - plant.gravity_torque - plant.viscous_friction * 0.9 * self.omega_load,
+            plant.load_inertia, plant.coulomb_friction * 0.9, dt,
+        )
+        self.theta_load += self.omega_load * dt
+        self._hard_stops_load()
+
+    def _brake(self, omega: float, driving: float, inertia: float, friction: float, dt: float) -> float:
+        """An engaged holding brake adds its torque to the dry friction of the motor shaft."""
+        if self.brake_engaged:
+            friction += self.plant.brake_torque
+        return _coulomb_step(omega, driving, inertia, friction, dt)
+
+    def _hard_stops_load(self) -> None:
+        low, high = self.plant.negative_hard_stop, self.plant.positive_hard_stop
+        self.stopped_at_hard_stop = False
+        if low is not None and self.theta_load <= low * TWO_PI and self.omega_load <= 0.0:
+            self.theta_load = low * TWO_PI
+            self.omega_load = 0.0
+            self.stopped_at_hard_stop = True
+        elif high is not None and self.theta_load >= high * TWO_PI and self.omega_load >= 0.0:
+            self.theta_load = high * TWO_PI
+            self.omega_load = 0.0
+            self.stopped_at_hard_stop = True
 
     # -- switches -----------------------------------------------------------------------------------------------
 

@@ -1,0 +1,180 @@
+"""Pydantic models of the project API (the contract); the dict views they are built from are shared with the CLI."""
+
+from __future__ import annotations
+
+from pydantic import BaseModel, Field
+
+from servostudio.services.projects import Bus, ParameterRow, Snapshot
+from servostudio.services.projects.jsonview import parameter_view, project_view
+
+
+class BusModel(BaseModel):
+    name: str = Field(examples=["sim"])
+    interface: str = Field(examples=["sim", "socketcan:can0"])
+    bitrate: int | None = Field(default=None, examples=[1000000])
+
+
+class AxisModel(BaseModel):
+    name: str = Field(examples=["X"])
+    device: str = Field(examples=["xtrapulspac"])
+    node_id: int = Field(examples=[1])
+    bus: str = Field(examples=["sim"])
+    description: str = ""
+    motor: str = ""
+    application: str = ""
+
+
+class ProjectModel(BaseModel):
+    name: str
+    description: str
+    buses: list[BusModel]
+    axes: list[AxisModel]
+    revision: str = Field(description="pass back with the next change (optimistic concurrency)")
+
+
+class ProjectSummary(BaseModel):
+    name: str
+    description: str
+    axis_count: int
+    revision: str
+    error: str | None = Field(description="why the project cannot be opened; null when it is fine")
+
+
+class ProjectCreate(BaseModel):
+    name: str
+    description: str = ""
+    buses: list[BusModel] = []
+
+
+class ProjectUpdate(BaseModel):
+    description: str | None = None
+    buses: list[BusModel] | None = None
+    revision: str | None = None
+
+
+class NewName(BaseModel):
+    new_name: str
+    revision: str | None = None
+
+
+class AxisCreate(AxisModel):
+    revision: str | None = None
+
+
+class AxisUpdate(BaseModel):
+    name: str | None = None
+    device: str | None = None
+    node_id: int | None = None
+    bus: str | None = None
+    description: str | None = None
+    revision: str | None = None
+
+
+Scalar = int | float | str | None
+
+
+class ParameterModel(BaseModel):
+    index: int
+    subindex: int
+    name: str = Field(description="e.g. '0x60F9,2 Speed loop gains.KPv'")
+    group: str
+    data_type: str
+    access: str
+    save_type: str
+    unit: str
+    value: Scalar = Field(description="project value: set in the axis files, else the default (raw units)")
+    default: Scalar
+    differs_from_default: bool
+    file: str | None = Field(description="DRIVEPAR.TXT / USER_PAR.TXT when the project sets it, else null")
+    editable: bool
+    not_editable_reason: str | None
+
+
+class ParameterList(BaseModel):
+    parameters: list[ParameterModel]
+    revision: str
+
+
+class ParameterWrite(BaseModel):
+    values: dict[str, int | float | str] = Field(examples=[{"0x6060": -3, "0x60F9,2": 1200}])
+    revision: str | None = None
+
+
+class ParameterReset(BaseModel):
+    addresses: list[str]
+    revision: str | None = None
+
+
+class CompareRowModel(BaseModel):
+    index: int
+    subindex: int
+    name: str
+    group: str
+    unit: str
+    values: dict[str, Scalar] = Field(description="column -> value; columns drive (with ?drive=true) / project / "
+                                                  "default")
+    differs: bool
+
+
+class CompareModel(BaseModel):
+    columns: list[str]
+    rows: list[CompareRowModel]
+    revision: str
+    refused: dict[str, str] = Field(default={}, description="objects the drive refused to read: address -> reason")
+
+
+class AxisChoiceModel(BaseModel):
+    changed: list[ParameterModel]
+    notes: list[str] = Field(description="consequences not reproduced offline, or reproduced without some inputs")
+    project: ProjectModel
+
+
+class MotorChoice(BaseModel):
+    reference: str
+    revision: str | None = None
+    drive: bool = Field(default=False, description="write the motor to the axis's live drive and read back what "
+                        "the drive derived")
+
+
+class TemplateChoice(BaseModel):
+    template: str = Field(examples=["analog-speed", "positioner", "stepper-emulation", "expert"])
+    revision: str | None = None
+
+
+class SettingModel(BaseModel):
+    index: int
+    subindex: int
+    value: int
+    why: str
+
+
+class TemplateModel(BaseModel):
+    key: str
+    title: str
+    description: str
+    settings: list[SettingModel]
+    groups: list[str] | None = Field(description="parameter groups the UI shows; null = all (Expert mode)")
+
+
+class MotorModel(BaseModel):
+    reference: str
+    description: str = ""
+    source: str = ""
+    motor_data: dict[str, int | str] = Field(description="0x6410 sub-entries by name, raw object units")
+    objects: dict[str, int | float | str] = Field(default={}, description='other objects, keys like "0x3324,1"')
+    builtin: bool = False
+
+
+# ---- conversions (the dict views are shared with the CLI) ---------------------------------------------------------
+
+def project_model(snapshot: Snapshot) -> ProjectModel:
+    return ProjectModel(**project_view(snapshot))
+
+
+def parameter_model(row: ParameterRow) -> ParameterModel:
+    return ParameterModel(**parameter_view(row))
+
+
+def buses_from(models: list[BusModel]) -> tuple[Bus, ...]:
+    return tuple(Bus(b.name, b.interface, b.bitrate) for b in models)
+

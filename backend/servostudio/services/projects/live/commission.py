@@ -1,0 +1,216 @@
+"""Commission from a project: check every axis's drive, then download the project to the drives or upload the
+drives into the project. One report per axis; an axis that fails does not stop the others.
+
+Download makes each drive hold the project's values: a drive freshly loaded with the axis files holds the file
+values and the dictionary default of everything else (docs/projects.md §4), so the files sent are *complete* — every
+object drive and project exchange, with its project value — and go through ``services.backup.restore_file``
+(validated as a whole before the first write, written, read back, stored to flash). Objects the project gives no
+value (no default, not set) are not sent and keep the drive's value; the report counts them. SEQUENCE.TXT is
+restored as the project holds it (an empty file clears the drive's sequences).
+
+Upload reads the drives' files with ``services.backup.backup_drive`` into a scratch directory, checks them against
+the axis's dictionary, and then replaces the axis files of every uploaded axis in one project change.
+"""
+
+from __future__ import annotations
+
+import shutil
+import tempfile
+from collections.abc import Callable, Iterable, Mapping
+from concurrent.futures import ThreadPoolExecutor
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from servostudio.drive.access import Drive
+from servostudio.formats.objectfile import ObjectEntry, format_object_file, write_object_file
+from servostudio.services.backup import FileKind, backup_drive, drive_file_kinds, restore_file
+from servostudio.services.bus import ConnectionManager
+from servostudio.services.projects import layout
+from servostudio.services.projects.axisvalues import AxisValues
+from servostudio.services.projects.errors import ConflictError, ProjectError, ValidationError
+from servostudio.services.projects.live.links import AxisLink, link_axes
+from servostudio.services.projects.service import ProjectService
+from servostudio.services.projects.values import to_file_value
+
+Progress = Callable[[dict[str, object]], None]
+DIRECTIONS = ("check", "download", "upload")
+
+
+@dataclass
+class AxisReport:
+    link: AxisLink
+    files: list[dict[str, object]] = field(default_factory=list)
+    error: str = ""
+
+    @property
+    def ok(self) -> bool:
+        return self.link.ok and not self.error and all(item.get("ok", True) for item in self.files)
+
+    def as_dict(self) -> dict[str, object]:
+        return {**self.link.as_dict(), "ok": self.ok, "error": self.error or None, "files": self.files}
+
+
+@dataclass
+class CommissionReport:
+    project: str
+    direction: str
+    axes: list[AxisReport]
+    revision: str
+
+    @property
+    def ok(self) -> bool:
+        return all(report.ok for report in self.axes)
+
+    def as_dict(self) -> dict[str, object]:
+        return {"project": self.project, "direction": self.direction, "ok": self.ok, "revision": self.revision,
+                "axes": [report.as_dict() for report in self.axes]}
+
+
+def commission(service: ProjectService, manager: ConnectionManager, project: str, direction: str = "check",
+               axes: Iterable[str] | None = None, buses: Mapping[str, str] | None = None,
+               expected_revision: str | None = None, progress: Progress | None = None) -> CommissionReport:
+    """Check the chosen axes (all by default), then download or upload the usable ones."""
+    if direction not in DIRECTIONS:
+        raise ValidationError(f"direction must be one of {', '.join(DIRECTIONS)}, not {direction!r}")
+    snapshot = service.store.open(project)
+    if expected_revision is not None and snapshot.revision != expected_revision:
+        raise ConflictError(project, expected_revision, snapshot.revision)
+    links = link_axes(snapshot.project, manager, axes, buses)
+    reports = [AxisReport(link) for link in links]
+    usable = [report for report in reports if report.link.ok]
+    _notify(progress, project, "identified", [link.as_dict() for link in links])
+    with tempfile.TemporaryDirectory(prefix="servostudio-commission-") as scratch:
+        if direction == "download":
+            copies = _copy_axis_files(service, project, [report.link for report in usable], Path(scratch))
+            _parallel(usable, lambda report: _download(report, copies[report.link.axis.name], Path(scratch),
+                                                       progress, project))
+        elif direction == "upload":
+            _parallel(usable, lambda report: _backup(report, Path(scratch) / report.link.axis.name, progress,
+                                                     project))
+            revision = _install(service, project, [r for r in usable if not r.error], Path(scratch),
+                                expected_revision or snapshot.revision)
+            return CommissionReport(project, direction, reports, revision)
+    return CommissionReport(project, direction, reports, service.store.open(project).revision)
+
+
+# ---- download ---------------------------------------------------------------------------------------------------
+
+@dataclass(frozen=True)
+class _AxisCopy:
+    directory: Path                       # the axis's files as they were when the download started
+    values: AxisValues
+
+
+def _copy_axis_files(service: ProjectService, project: str, links: list[AxisLink],
+                     scratch: Path) -> dict[str, _AxisCopy]:
+    """Snapshot the axis files under the project's read lock, so the download sends one consistent state."""
+    copies = {}
+    with service.store.read(project) as view:
+        for link in links:
+            source, target = view.axis_directory(link.axis.name), scratch / "project" / link.axis.name
+            shutil.copytree(source, target, ignore=shutil.ignore_patterns(f"{layout.TEMP_PREFIX}*"))
+            values = service.parameters.axis_values(view, link.axis.name)
+            copies[link.axis.name] = _AxisCopy(target, values)
+    return copies
+
+
+def _download(report: AxisReport, copy: _AxisCopy, scratch: Path, progress: Progress | None,
+              project: str) -> None:
+    drive = report.link.drive()
+    relay = _relay(progress, project, report.link)
+    outgoing = scratch / "download" / report.link.axis.name
+    outgoing.mkdir(parents=True)
+    for kind in drive_file_kinds(drive):
+        if kind is FileKind.SEQUENCE:
+            source = copy.directory / layout.SEQUENCE
+            if not source.is_file():
+                continue
+            result = restore_file(drive, source, kind, relay).as_dict()
+        else:
+            path = outgoing / kind.value
+            left_out = _complete_file(copy.values, kind, path)
+            result = restore_file(drive, path, kind, relay).as_dict()
+            result["not_in_project"] = left_out
+        result["file"] = kind.value
+        report.files.append(result)
+        if not result["ok"]:
+            return  # later files would be stored on top of a failed one
+
+
+def _complete_file(values: AxisValues, kind: FileKind, path: Path) -> list[str]:
+    """Write every exchanged object of this file's save type with its project value; return the objects left out
+    (no project value, or a text the object file cannot spell)."""
+    entries, left_out = [], []
+    for variable in values.transferable():
+        if variable.save_type is not kind.save_type:
+            continue
+        value = values.value(variable)
+        entry = ObjectEntry(variable.index, variable.subindex, to_file_value(variable, value)) if value is not None \
+            else None
+        if entry is not None and isinstance(entry.value, str):
+            try:
+                format_object_file([entry])
+            except ValueError:
+                entry = None
+        if entry is None:
+            left_out.append(variable.label)
+        else:
+            entries.append(entry)
+    write_object_file(path, entries, header=f"{kind.value}: project values for {values.dictionary.device} node "
+                                            f"{values.node_id}, Servo Studio download")
+    return left_out
+
+
+# ---- upload -----------------------------------------------------------------------------------------------------
+
+def _backup(report: AxisReport, directory: Path, progress: Progress | None, project: str) -> None:
+    drive: Drive = report.link.drive()
+    results = backup_drive(drive, directory, drive_file_kinds(drive), _relay(progress, project, report.link))
+    report.files = [{**result.as_dict(), "file": result.kind, "ok": True} for result in results]
+
+
+def _install(service: ProjectService, project: str, reports: list[AxisReport], scratch: Path,
+             expected_revision: str) -> str:
+    """Replace the uploaded axes' files in one project change (refused if the project changed meanwhile)."""
+    if not reports:
+        return service.store.open(project).revision
+    with service.store.edit(project, expected_revision) as edit:
+        for report in reports:  # the revision check above guarantees the axes are the ones identified
+            axis = report.link.axis
+            try:
+                AxisValues.load(scratch / axis.name, service.parameters.dictionary(axis), axis.node_id)
+            except ProjectError as error:
+                report.error = f"uploaded files refused: {error}"
+        for report in reports:
+            if report.error:
+                continue
+            for item in report.files:
+                edit.write_axis_file(report.link.axis.name, str(item["file"]),
+                                     (scratch / report.link.axis.name / str(item["file"])).read_bytes())
+    return edit.revision
+
+
+# ---- helpers ----------------------------------------------------------------------------------------------------
+
+def _parallel(reports: list[AxisReport], work: Callable[[AxisReport], None]) -> None:
+    """Run ``work`` for every axis at once; a failure is recorded in that axis's report."""
+    if not reports:
+        return
+    with ThreadPoolExecutor(max_workers=len(reports), thread_name_prefix="commission") as pool:
+        futures = [(report, pool.submit(work, report)) for report in reports]
+        for report, future in futures:
+            try:
+                future.result()
+            except Exception as error:  # reported per axis; the other axes go on
+                report.error = str(error)
+
+
+def _relay(progress: Progress | None, project: str, link: AxisLink) -> Progress | None:
+    if progress is None:
+        return None
+    return lambda event: progress({**event, "project": project, "axis": link.axis.name})
+
+
+def _notify(progress: Progress | None, project: str, step: str, axes: list[dict[str, object]]) -> None:
+    if progress is not None:
+        progress({"type": "progress", "operation": "commission", "project": project, "step": step, "axes": axes})
