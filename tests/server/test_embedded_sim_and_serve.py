@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import pytest
 
-from servostudio.cli.drive import check_local_host
+from servostudio.cli import check_bind_host
 from servostudio.cli.output import CommandError
 from servostudio.services.bus import ConnectionManager
 from servostudio.services.scan import scan
@@ -25,13 +25,14 @@ def test_sim_bus_builds_and_stops_its_drives():
 
 @pytest.mark.parametrize("host", ["127.0.0.1", "::1", "localhost", "127.0.0.2"])
 def test_serve_accepts_loopback(host):
-    check_local_host(host)
+    check_bind_host(host, allow_remote=False)
 
 
 @pytest.mark.parametrize("host", ["0.0.0.0", "192.168.1.10", "example.org"])
 def test_serve_refuses_other_addresses(host):
     with pytest.raises(CommandError, match="localhost only"):
-        check_local_host(host)
+        check_bind_host(host, allow_remote=False)
+    check_bind_host(host, allow_remote=True)  # explicit opt-in, e.g. inside the container
 
 
 def test_cd1k_restore_refuses_to_store_while_enabled(commission, tmp_path):

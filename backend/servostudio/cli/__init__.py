@@ -7,11 +7,12 @@ so scripts can chain them.
 from __future__ import annotations
 
 import argparse
+import ipaddress
 import sys
 from pathlib import Path
 
 from servostudio.cli import drive, eds, project
-from servostudio.cli.output import CommandError
+from servostudio.cli.output import EXIT_USAGE, CommandError
 from servostudio.sim import cli as sim_cli
 
 
@@ -31,9 +32,23 @@ def _add_serve(commands: argparse._SubParsersAction) -> None:
     serve.add_argument("--host", default="127.0.0.1", help="address to bind (default: 127.0.0.1)")
     serve.add_argument("--port", type=int, default=8000, help="TCP port (default: 8000)")
     serve.add_argument("--projects", type=Path, default=Path("projects"), help="project store directory")
+    serve.add_argument("--allow-remote", action="store_true",
+                       help="accept a non-loopback --host (there is no login yet: only inside a container or a "
+                            "trusted network)")
     serve.add_argument("--bus", action="append", default=[], metavar="SPEC",
                        help="bus to open at startup, repeatable (default: sim, the embedded simulated drives)")
     serve.set_defaults(handler=_serve)
+
+
+def check_bind_host(host: str, allow_remote: bool) -> None:
+    """The communication server binds to this machine only, unless explicitly told otherwise."""
+    try:
+        local = host == "localhost" or ipaddress.ip_address(host).is_loopback
+    except ValueError:
+        local = False
+    if not (local or allow_remote):
+        raise CommandError(f"--host {host}: the server binds to localhost only (127.0.0.1, ::1); "
+                           "pass --allow-remote to accept connections from other machines", EXIT_USAGE)
 
 
 def _serve(args: argparse.Namespace) -> int:
@@ -41,7 +56,7 @@ def _serve(args: argparse.Namespace) -> int:
 
     from servostudio.api.app import Settings, create_app
 
-    drive.check_local_host(args.host)
+    check_bind_host(args.host, args.allow_remote)
     app = create_app(Settings(projects_dir=args.projects, buses=args.bus or ["sim"]))
     uvicorn.run(app, host=args.host, port=args.port, log_level="info")
     return 0

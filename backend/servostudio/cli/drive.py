@@ -7,7 +7,6 @@ Each command opens the bus, does its work, prints JSON on stdout and exits with 
 from __future__ import annotations
 
 import argparse
-import ipaddress
 from collections.abc import Callable
 from pathlib import Path
 
@@ -15,7 +14,6 @@ from servostudio.cli.output import (
     EXIT_COMMUNICATION,
     EXIT_INVALID_INPUT,
     EXIT_NOT_FOUND,
-    EXIT_USAGE,
     CommandError,
     emit,
 )
@@ -79,16 +77,6 @@ def register(commands: argparse._SubParsersAction) -> None:
     state = add("state", "show the CiA 402 state, or walk to TARGET", _state)
     state.add_argument("target", nargs="?", help="switch-on-disabled, ready-to-switch-on, switched-on, "
                        "operation-enabled, quick-stop-active")
-
-
-def check_local_host(host: str) -> None:
-    """The communication server binds to this machine only (it has no authentication yet)."""
-    try:
-        local = host == "localhost" or ipaddress.ip_address(host).is_loopback
-    except ValueError:
-        local = False
-    if not local:
-        raise CommandError(f"--host {host}: the server binds to localhost only (127.0.0.1, ::1)", EXIT_USAGE)
 
 
 def _run(args: argparse.Namespace, handler: Callable[[argparse.Namespace, BusConnection], object]) -> int:
