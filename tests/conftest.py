@@ -56,7 +56,8 @@ class LiveServer:
         self._log_file.close()
 
 
-@pytest.fixture(scope="session")
+# Module scope: the server runs three simulated drives in real time; it must not outlive the tests using it.
+@pytest.fixture(scope="module")
 def live_server(tmp_path_factory: pytest.TempPathFactory):
     root = tmp_path_factory.mktemp("live")
     projects = root / "projects"

@@ -1,18 +1,264 @@
 /** Typed access to the communication server's REST API (same origin). */
 
+import type { Dictionary, DictionarySummary, Scalar } from "./lib/od";
+
 export interface Health {
   status: string;
   version: string;
 }
 
-export async function getJson<T>(path: string, fetchImpl: typeof fetch = fetch): Promise<T> {
-  const response = await fetchImpl(path, { headers: { Accept: "application/json" } });
-  if (!response.ok) {
-    throw new Error(`${path}: HTTP ${response.status}`);
+/** A refusal of the server, with its message (FastAPI `detail`, a `{error, message}` body, or a validation list). */
+export class ApiError extends Error {
+  constructor(
+    readonly status: number,
+    message: string,
+    readonly kind = "",
+  ) {
+    super(message);
   }
+}
+
+export async function errorOf(path: string, response: Response): Promise<ApiError> {
+  let body: unknown = null;
+  try {
+    body = await response.json();
+  } catch {
+    // Not JSON (a proxy error page, say): the status line is all there is.
+  }
+  const detail = (body as { detail?: unknown } | null)?.detail ?? body;
+  if (typeof detail === "string") return new ApiError(response.status, detail);
+  if (Array.isArray(detail)) {
+    const text = detail
+      .map((item: { loc?: unknown[]; msg?: string }) => `${(item.loc ?? []).slice(1).join(".")}: ${item.msg ?? ""}`)
+      .join("; ");
+    return new ApiError(response.status, text || `${path}: HTTP ${response.status}`);
+  }
+  if (detail && typeof detail === "object" && "message" in detail) {
+    const { message, error } = detail as { message: string; error?: string };
+    return new ApiError(response.status, message, error ?? "");
+  }
+  return new ApiError(response.status, `${path}: HTTP ${response.status}`);
+}
+
+export async function request<T>(
+  method: string,
+  path: string,
+  body?: unknown,
+  fetchImpl: typeof fetch = fetch,
+  signal?: AbortSignal,
+): Promise<T> {
+  const init: RequestInit = { method, headers: { Accept: "application/json" }, signal };
+  if (body instanceof FormData || body instanceof Blob) {
+    init.body = body;
+    if (body instanceof Blob && body.type) (init.headers as Record<string, string>)["Content-Type"] = body.type;
+  } else if (body !== undefined) {
+    init.body = JSON.stringify(body);
+    (init.headers as Record<string, string>)["Content-Type"] = "application/json";
+  }
+  const response = await fetchImpl(path, init);
+  if (!response.ok) throw await errorOf(path, response);
+  if (response.status === 204) return undefined as T;
   return (await response.json()) as T;
 }
 
+export function getJson<T>(path: string, fetchImpl: typeof fetch = fetch): Promise<T> {
+  return request<T>("GET", path, undefined, fetchImpl);
+}
+
+export const get = <T>(path: string, signal?: AbortSignal) => request<T>("GET", path, undefined, fetch, signal);
+export const post = <T>(path: string, body?: unknown) => request<T>("POST", path, body ?? {});
+export const put = <T>(path: string, body: unknown) => request<T>("PUT", path, body);
+export const patch = <T>(path: string, body: unknown) => request<T>("PATCH", path, body);
+export const del = <T>(path: string) => request<T>("DELETE", path);
+
 export function getHealth(fetchImpl: typeof fetch = fetch): Promise<Health> {
   return getJson<Health>("/api/health", fetchImpl);
+}
+
+const e = encodeURIComponent;
+
+// ---- dictionaries -----------------------------------------------------------------------------------------------
+
+const dictionaryCache = new Map<string, Promise<Dictionary>>();
+
+/** Dictionaries do not change while the server runs (imports add new keys), so each is fetched once. */
+export function getDictionary(device: string): Promise<Dictionary> {
+  let cached = dictionaryCache.get(device);
+  if (!cached) {
+    cached = get<Dictionary>(`/api/dictionaries/${e(device)}`);
+    cached.catch(() => dictionaryCache.delete(device));
+    dictionaryCache.set(device, cached);
+  }
+  return cached;
+}
+
+export const listDictionaries = () => get<DictionarySummary[]>("/api/dictionaries");
+
+export function importDictionary(eds: File, props: File | null): Promise<DictionarySummary> {
+  const form = new FormData();
+  form.append("eds", eds);
+  if (props) form.append("props", props);
+  return post<DictionarySummary>("/api/dictionaries", form);
+}
+
+// ---- projects ---------------------------------------------------------------------------------------------------
+
+export interface BusConfig {
+  name: string;
+  interface: string;
+  bitrate: number | null;
+}
+
+export interface AxisConfig {
+  name: string;
+  device: string;
+  node_id: number;
+  bus: string;
+  description: string;
+  motor: string;
+  application: string;
+}
+
+export interface Project {
+  name: string;
+  description: string;
+  buses: BusConfig[];
+  axes: AxisConfig[];
+  revision: string;
+}
+
+export interface ProjectSummary {
+  name: string;
+  description: string;
+  axis_count: number;
+  revision: string;
+}
+
+export interface ProjectParameter {
+  index: number;
+  subindex: number;
+  name: string;
+  group: string;
+  data_type: string;
+  access: string;
+  save_type: string;
+  unit: string;
+  value: Scalar;
+  default: Scalar;
+  differs_from_default: boolean;
+  file: string | null;
+  editable: boolean;
+  not_editable_reason: string | null;
+}
+
+export interface ParameterList {
+  parameters: ProjectParameter[];
+  revision: string;
+}
+
+export interface CompareRow {
+  index: number;
+  subindex: number;
+  name: string;
+  group: string;
+  unit: string;
+  values: Record<string, Scalar>;
+  differs: boolean;
+}
+
+export interface Motor {
+  reference: string;
+  description: string;
+  source: string;
+  motor_data: Record<string, number | string>;
+  objects: Record<string, number | string>;
+  builtin: boolean;
+}
+
+export interface AxisChoice {
+  changed: ProjectParameter[];
+  skipped: string[];
+  project: Project;
+}
+
+export interface Template {
+  key: string;
+  title: string;
+  description: string;
+  settings: { index: number; subindex: number; value: number; why: string }[];
+  groups: string[] | null;
+}
+
+/** The address form of the projects API: `0x60F9,2`. */
+export function projectAddress(index: number, subindex: number): string {
+  return `0x${index.toString(16).toUpperCase().padStart(4, "0")},${subindex}`;
+}
+
+const axisPath = (project: string, axis: string) => `/api/projects/${e(project)}/axes/${e(axis)}`;
+
+export const projects = {
+  list: () => get<ProjectSummary[]>("/api/projects"),
+  get: (name: string) => get<Project>(`/api/projects/${e(name)}`),
+  create: (name: string, description: string, buses: BusConfig[]) =>
+    post<Project>("/api/projects", { name, description, buses }),
+  update: (name: string, change: { description?: string; buses?: BusConfig[]; revision?: string }) =>
+    patch<Project>(`/api/projects/${e(name)}`, change),
+  remove: (name: string, revision: string) => del<void>(`/api/projects/${e(name)}?revision=${e(revision)}`),
+  rename: (name: string, newName: string, revision: string) =>
+    post<Project>(`/api/projects/${e(name)}/rename`, { new_name: newName, revision }),
+  duplicate: (name: string, newName: string) => post<Project>(`/api/projects/${e(name)}/duplicate`, { new_name: newName }),
+  archiveUrl: (name: string) => `/api/projects/${e(name)}/archive`,
+  unarchive: (archive: Blob, newName?: string) =>
+    post<Project>(`/api/projects/unarchive${newName ? `?new_name=${e(newName)}` : ""}`,
+      new Blob([archive], { type: "application/zip" })),
+  addAxis: (project: string, axis: Omit<AxisConfig, "motor" | "application">, revision: string) =>
+    post<Project>(`/api/projects/${e(project)}/axes`, { ...axis, revision }),
+  editAxis: (project: string, axis: string, change: Partial<AxisConfig> & { revision: string }) =>
+    patch<Project>(axisPath(project, axis), change),
+  removeAxis: (project: string, axis: string, revision: string) =>
+    del<Project>(`${axisPath(project, axis)}?revision=${e(revision)}`),
+  parameters: (project: string, axis: string) =>
+    get<ParameterList>(`${axisPath(project, axis)}/parameters?include_unsaved=true`),
+  setParameters: (project: string, axis: string, values: Record<string, number | string>, revision?: string) =>
+    put<ParameterList>(`${axisPath(project, axis)}/parameters`, { values, revision }),
+  resetParameters: (project: string, axis: string, addresses: string[], revision?: string) =>
+    post<ParameterList>(`${axisPath(project, axis)}/parameters/reset`, { addresses, revision }),
+  compare: (project: string, axis: string, onlyDifferences: boolean) =>
+    get<{ columns: string[]; rows: CompareRow[]; revision: string }>(
+      `${axisPath(project, axis)}/compare?only_differences=${onlyDifferences}`,
+    ),
+  selectMotor: (project: string, axis: string, reference: string, revision: string) =>
+    post<AxisChoice>(`${axisPath(project, axis)}/motor`, { reference, revision }),
+  application: (project: string, axis: string) => get<Template | null>(`${axisPath(project, axis)}/application`),
+  applyApplication: (project: string, axis: string, template: string, revision: string) =>
+    post<AxisChoice>(`${axisPath(project, axis)}/application`, { template, revision }),
+  dcfUrl: (project: string, axis: string) => `${axisPath(project, axis)}/dcf`,
+  templates: (device: string) => get<Template[]>(`/api/device-templates?device=${e(device)}`),
+  motors: () => get<Motor[]>("/api/motors"),
+};
+
+/**
+ * Store many values in a project; values the project refuses (a drive may hold a value outside the dictionary's
+ * range) are left out one by one and reported, so one odd value does not block a backup of hundreds.
+ */
+export async function setParametersSkipping(
+  project: string,
+  axis: string,
+  values: Record<string, number | string>,
+): Promise<{ parameters: ProjectParameter[]; skipped: string[] }> {
+  const remaining = { ...values };
+  const skipped: string[] = [];
+  for (;;) {
+    try {
+      const answer = await projects.setParameters(project, axis, remaining);
+      return { parameters: answer.parameters, skipped };
+    } catch (error) {
+      const address = error instanceof ApiError && error.status === 422 ? /0x[0-9A-F]{4},\d+/i.exec(error.message)?.[0] : undefined;
+      const key = address && Object.keys(remaining).find((candidate) => candidate.toUpperCase() === address.toUpperCase());
+      if (!key) throw error;
+      skipped.push(error instanceof Error ? error.message : String(error));
+      delete remaining[key];
+      if (Object.keys(remaining).length === 0) return { parameters: [], skipped };
+    }
+  }
 }

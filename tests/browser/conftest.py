@@ -6,11 +6,19 @@ Playwright's own browser download is not available here, so the browser is the s
 
 from __future__ import annotations
 
+import os
 import shutil
+from dataclasses import dataclass
 from pathlib import Path
 
+import httpx
 import pytest
-from playwright.sync_api import Browser, Page, sync_playwright
+from playwright.sync_api import Browser, Page, expect, sync_playwright
+
+from tests.conftest import REPO_ROOT, LiveServer
+
+# The test machine is shared and slow at times: allow pages more than Playwright's default 5 s to settle.
+expect.set_options(timeout=15_000)
 
 ARTIFACTS = Path(__file__).resolve().parents[2] / "test-artifacts" / "screenshots"
 CHROMIUM_ARGS = [
@@ -51,3 +59,56 @@ def screenshot(page: Page, name: str) -> Path:
     path = ARTIFACTS / f"{name}.png"
     page.screenshot(path=str(path), full_page=True)
     return path
+
+
+@dataclass(frozen=True)
+class DemoServer:
+    """A real `servostudio serve` whose project store holds a copy of the shipped demo project, with its bus open."""
+
+    url: str
+    project: str
+    bus: str
+    axes: tuple[tuple[str, int], ...]  # (axis name, node ID)
+
+    def api(self, method: str, path: str, **kwargs) -> httpx.Response:
+        response = httpx.request(method, self.url + path, timeout=15.0, **kwargs)
+        assert response.is_success, f"{method} {path}: HTTP {response.status_code} {response.text}"
+        return response
+
+
+@pytest.fixture(scope="package")
+def demo_server(tmp_path_factory: pytest.TempPathFactory):
+    """The UI tests' server: the repository's projects/demo copied into a fresh project store (tests may change it)."""
+    root = tmp_path_factory.mktemp("ui")
+    projects = root / "projects"
+    shutil.copytree(REPO_ROOT / "projects" / "demo", projects / "demo")
+    # EDS imports made by the tests go to a scratch library, not the user's (the server reads this at start-up).
+    previous = os.environ.get("SERVOSTUDIO_USER_EDS_DIR")
+    os.environ["SERVOSTUDIO_USER_EDS_DIR"] = str(root / "user-eds")
+    try:
+        server = LiveServer(projects)
+    finally:
+        if previous is None:
+            del os.environ["SERVOSTUDIO_USER_EDS_DIR"]
+        else:
+            os.environ["SERVOSTUDIO_USER_EDS_DIR"] = previous
+    try:
+        server.wait_ready()
+        project = httpx.get(f"{server.url}/api/projects/demo", timeout=15.0).json()
+        bus = project["buses"][0]
+        # The UI maps a project bus to the server's bus of the same name, else of the same spec; so does the test.
+        open_buses = httpx.get(f"{server.url}/api/buses", timeout=15.0).json()
+        match = next((b for b in open_buses if b["id"] == bus["name"]), None) or next(
+            (b for b in open_buses if b["spec"] == bus["interface"]), None)
+        if match is None:
+            match = httpx.post(f"{server.url}/api/buses", json={"spec": bus["interface"], "id": bus["name"]},
+                               timeout=30.0).json()
+        yield DemoServer(server.url, "demo", match["id"], tuple((a["name"], a["node_id"]) for a in project["axes"]))
+    finally:
+        server.stop()
+
+
+@pytest.fixture(scope="package")
+def live_server(demo_server: DemoServer) -> DemoServer:
+    """The browser tests share one server (each runs three simulated drives in real time on a 2-core machine)."""
+    return demo_server

@@ -1,0 +1,80 @@
+/** The pages of one axis: header with device, node and live state, tabs, and the chosen view. */
+
+import type { Page, PageContext } from "../app";
+import { getDictionary, projects, type AxisConfig, type Project } from "../api";
+import { h } from "../lib/dom";
+import type { Dictionary } from "../lib/od";
+import { buildPath, type AxisView } from "../lib/router";
+import { axisStateText } from "../live";
+import { backupView } from "./backup";
+import { commissioningView } from "./commissioning";
+import { dashboardView } from "./dashboard";
+import { parametersView } from "./axisparams";
+
+export interface AxisContext {
+  page: PageContext;
+  project: Project;
+  axis: AxisConfig;
+  dictionary: Dictionary;
+}
+
+export interface AxisViewPage {
+  element: HTMLElement;
+  update?: Page["update"];
+  dispose?(): void;
+  focusSearch?(): boolean;
+}
+
+const VIEWS: [AxisView, string, string][] = [
+  ["dashboard", "Dashboard", "g d"],
+  ["parameters", "Parameters", "g p"],
+  ["commissioning", "Commissioning", "g c"],
+  ["backup", "Backup / restore", "g k"],
+];
+
+export async function axisPage(context: PageContext, projectName: string, axisName: string, view: AxisView): Promise<Page> {
+  // The tree already knows the axis's device: fetch its dictionary while the project is fetched.
+  const known = context.app.projectsLoaded().find((p) => p.name === projectName)?.axes.find((a) => a.name === axisName);
+  const early = known ? getDictionary(known.device) : null;
+  early?.catch(() => undefined);
+  const project = await projects.get(projectName);
+  const axis = project.axes.find((candidate) => candidate.name === axisName);
+  if (!axis) {
+    throw new Error(`Project ${projectName} has no axis "${axisName}" (axes: ${project.axes.map((a) => a.name).join(", ") || "none"}).`);
+  }
+  const dictionary = await (known?.device === axis.device && early ? early : getDictionary(axis.device));
+  const axisContext: AxisContext = { page: context, project, axis, dictionary };
+  const viewPage = await (view === "dashboard" ? dashboardView(axisContext)
+    : view === "parameters" ? parametersView(axisContext)
+      : view === "commissioning" ? commissioningView(axisContext)
+        : backupView(axisContext));
+
+  const state = h("span", { class: "pill", "data-testid": "axis-live-state" });
+  const drawState = () => {
+    const text = axisStateText(context.app.live.axis(axis.bus, axis.node_id));
+    state.replaceChildren(h("span", { class: `dot ${text.tone}` }), text.text);
+  };
+  drawState();
+  const unsubscribe = context.app.live.onChange(drawState);
+  const tabs = h("nav", { class: "tabs" }, VIEWS.map(([key, label, keys]) => h("a", {
+    href: buildPath({ page: "axis", project: project.name, axis: axis.name, view: key }),
+    class: key === view ? "active" : "", title: `${label} (${keys})`, "data-testid": `tab-${key}`,
+  }, label)));
+  const head = h("div", { class: "page-head" },
+    h("h1", { "data-testid": "axis-title" }, axis.name),
+    h("span", { class: "muted" }, `${dictionary.product_name} · node ${axis.node_id} · bus ${axis.bus}${axis.motor ? ` · motor ${axis.motor}` : ""}`),
+    state);
+  const wrapper = h("div", { class: "page", style: { paddingBottom: "0", flex: "none" } }, head, tabs);
+  viewPage.element.style.flex = "1";
+  return {
+    title: `${axis.name} ${VIEWS.find(([key]) => key === view)![1]}`,
+    crumbs: [h("a", { href: "/" }, "Projects"), " / ", h("a", { href: buildPath({ page: "project", project: project.name }) }, project.name), ` / ${axis.name}`],
+    element: h("div", { style: { display: "flex", flexDirection: "column", flex: "1", minHeight: "0" } }, wrapper, viewPage.element),
+    update: viewPage.update,
+    focusSearch: viewPage.focusSearch,
+    dispose: () => {
+      unsubscribe();
+      viewPage.dispose?.();
+    },
+  };
+}

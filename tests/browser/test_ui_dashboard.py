@@ -1,0 +1,55 @@
+"""Axis dashboard against the simulated drives: enabling needs explicit clicks and the state follows."""
+
+import re
+
+from playwright.sync_api import Page, expect
+
+from .conftest import DemoServer, screenshot
+
+
+def drive_state(server: DemoServer, node: int) -> str:
+    return server.api("GET", f"/api/buses/{server.bus}/nodes/{node}/state").json()["state"]
+
+
+def test_live_values_and_enabling_the_axis_step_by_step(page: Page, demo_server: DemoServer) -> None:
+    axis, node = demo_server.axes[1]
+    page.goto(f"{demo_server.url}/projects/demo/axes/{axis}")
+    dc_bus = page.get_by_test_id("readout-0x6079,0").locator(".value")
+    expect(dc_bus).to_have_text(re.compile(r"^\d+(\.\d+)?$"))
+    assert float(dc_bus.inner_text()) > 0
+    expect(page.get_by_test_id("io-outputs").locator(".led")).not_to_have_count(0)
+    state = page.get_by_test_id("dashboard-state")
+    expect(state).not_to_have_text("—")
+    if state.inner_text() != "Switch on disabled":  # leave whatever an earlier run left behind
+        page.get_by_test_id("transition-disable_voltage").click()
+    expect(state).to_have_text("Switch on disabled")
+    assert drive_state(demo_server, node) == "SWITCH ON DISABLED"
+    expect(page.get_by_test_id("transition-enable_operation")).to_have_count(0)
+
+    page.get_by_test_id("transition-shutdown").click()
+    expect(state).to_have_text("Ready to switch on")
+    page.get_by_test_id("transition-switch_on").click()
+    expect(state).to_have_text("Switched on")
+    page.get_by_test_id("transition-enable_operation").click()
+    expect(state).to_have_text("Operation enabled")
+    assert drive_state(demo_server, node) == "OPERATION ENABLED"
+    expect(page.get_by_test_id(f"tree-state-{axis}")).to_have_text("Operation enabled")
+    expect(page.locator('[data-testid="dashboard-sw-bits"] .set', has_text="Operation enabled")).to_have_count(1)
+    expect(page.get_by_test_id("no-faults")).to_be_visible()
+
+    expect(page.get_by_test_id("qt-acceleration")).not_to_have_value("")
+    page.get_by_test_id("qt-velocity").fill("20000")
+    page.get_by_test_id("qt-run").click()
+    velocity = page.get_by_test_id("readout-0x606C,0").locator(".value")
+    expect(velocity).to_have_text(re.compile(r"^(19\d{3}|20\d{3})$"))
+    expect(page.get_by_test_id("dashboard-mode")).to_have_text("Profile velocity (3)")
+    on_drive = demo_server.api("GET", f"/api/buses/{demo_server.bus}/nodes/{node}/objects/0x606C,0").json()["raw"]
+    assert abs(on_drive - 20000) < 1000
+    screenshot(page, "dashboard-enabled")
+    page.get_by_test_id("qt-stop").click()
+    expect(velocity).to_have_text(re.compile(r"^-?\d{1,2}$"))
+
+    page.get_by_test_id("transition-disable_voltage").click()
+    expect(state).to_have_text("Switch on disabled")
+    assert drive_state(demo_server, node) == "SWITCH ON DISABLED"
+
