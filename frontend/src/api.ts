@@ -71,6 +71,11 @@ export const put = <T>(path: string, body: unknown) => request<T>("PUT", path, b
 export const patch = <T>(path: string, body: unknown) => request<T>("PATCH", path, body);
 export const del = <T>(path: string) => request<T>("DELETE", path);
 
+/** Who the server says we are (name and user level). */
+export function getMe(fetchImpl: typeof fetch = fetch): Promise<{ name: string; level: string }> {
+  return getJson<{ name: string; level: string }>("/api/me", fetchImpl);
+}
+
 export function getHealth(fetchImpl: typeof fetch = fetch): Promise<Health> {
   return getJson<Health>("/api/health", fetchImpl);
 }

@@ -3,7 +3,7 @@
  * keyboard shortcuts and theme. Pages are plain modules that build their element from a `PageContext`.
  */
 
-import { getHealth, projects, type Project } from "./api";
+import { getHealth, getMe, projects, type Project } from "./api";
 import { errorText } from "./components/ui";
 import { h, replaceChildren } from "./lib/dom";
 import { BINDINGS, KeyMatcher } from "./lib/keys";
@@ -93,6 +93,7 @@ export class App {
   async start(): Promise<void> {
     this.setServer("connecting");
     void this.refreshHealth();
+    void getMe().then((user) => this.live.setUser(user), () => undefined);
     setInterval(() => void this.refreshHealth(), 10000);
     this.live.refreshAxis = async (axis) => {
       try {

@@ -13,6 +13,7 @@ def test_shell_shows_live_server_version(page: Page, live_server) -> None:
     expect(status).to_have_text(f"Server online · v{__version__}")
     expect(status).to_have_attribute("data-state", "online")
     expect(page).to_have_title("Servo Studio")
+    expect(page.get_by_test_id("user-status")).to_have_text("local · administrator")
     screenshot(page, "shell")
 
 

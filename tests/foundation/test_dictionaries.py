@@ -182,7 +182,7 @@ def test_bad_eds_is_refused_with_line_and_nothing_kept(client: TestClient, tmp_p
     assert response.status_code == 422
     detail = response.json()["detail"]
     line = broken.splitlines().index("LowLimit=-10") + 1
-    assert f"acme.eds:{line}:" in detail and "[2000]" in detail
+    assert detail.startswith(f"acme.eds:{line}: [2000]"), detail
     assert not (tmp_path / "user-eds" / "acme.eds").exists()
 
 
@@ -216,3 +216,7 @@ def test_cli_check_rejects_a_malformed_file_with_exit_3(tmp_path: Path) -> None:
     result = run_cli("eds", "check", str(eds))
     assert result.returncode == 3
     assert "acme.eds:" in result.stderr and "[2000]" in result.stderr
+
+
+def test_me_names_the_caller_and_level(client: TestClient) -> None:
+    assert client.get("/api/me").json() == {"name": "local", "level": "administrator"}

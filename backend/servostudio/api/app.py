@@ -15,7 +15,7 @@ from fastapi.staticfiles import StaticFiles
 
 from servostudio import __version__
 from servostudio.api.deps import install_communication
-from servostudio.api.routes import backup, buses, dictionaries, drives, events, health, projects
+from servostudio.api.routes import backup, buses, dictionaries, drives, events, health, projects, users
 from servostudio.api.routes.errors import register_error_handlers
 from servostudio.od import BUILTIN_EDS_DIR, EdsLibrary
 from servostudio.od.library import DEFAULT_USER_EDS_DIR
@@ -43,6 +43,7 @@ def create_app(settings: Settings | None = None) -> FastAPI:
     app.state.settings = settings
     app.state.eds_library = EdsLibrary(BUILTIN_EDS_DIR, settings.user_eds_dir)
     app.include_router(health.router, prefix="/api")
+    app.include_router(users.router, prefix="/api")
     app.include_router(dictionaries.router, prefix="/api")
     app.include_router(projects.router, prefix="/api")
     install_communication(app, settings.buses)

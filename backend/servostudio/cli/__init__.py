@@ -14,6 +14,7 @@ from pathlib import Path
 
 from servostudio.cli import drive, eds, project
 from servostudio.cli.output import EXIT_USAGE, CommandError
+from servostudio.od.library import DEFAULT_USER_EDS_DIR
 from servostudio.sim import cli as sim_cli
 
 
@@ -33,6 +34,8 @@ def _add_serve(commands: argparse._SubParsersAction) -> None:
     serve.add_argument("--host", default="127.0.0.1", help="address to bind (default: 127.0.0.1)")
     serve.add_argument("--port", type=int, default=8000, help="TCP port (default: 8000)")
     serve.add_argument("--projects", type=Path, default=Path("projects"), help="project store directory")
+    serve.add_argument("--user-eds", type=Path, default=DEFAULT_USER_EDS_DIR, metavar="DIR",
+                       help=f"directory of imported EDS files (default: {DEFAULT_USER_EDS_DIR})")
     serve.add_argument("--allow-remote", action="store_true",
                        help="accept a non-loopback --host (there is no login yet: only inside a container or a "
                             "trusted network)")
@@ -58,7 +61,7 @@ def _serve(args: argparse.Namespace) -> int:
     from servostudio.api.app import Settings, create_app
 
     check_bind_host(args.host, args.allow_remote)
-    app = create_app(Settings(projects_dir=args.projects, buses=args.bus or ["sim"]))
+    app = create_app(Settings(projects_dir=args.projects, user_eds_dir=args.user_eds, buses=args.bus or ["sim"]))
     uvicorn.run(app, host=args.host, port=args.port, log_level="info")
     return 0
 

@@ -16,7 +16,7 @@ class BusOpen(BaseModel):
     spec: str = Field(description="bus spec: socketcan:can0, pcan:PCAN_USBBUS1@1000000, ixxat:0@500000, kvaser:0, "
                                    "slcan:/dev/ttyACM0@1000000, socketcand:HOST:PORT[/CH], virtual:NAME, "
                                    "serial:PORT_OR_URL[@BAUD], sim[:NODES]")
-    id: str | None = Field(None, description="name of the bus in later calls (default bus0, bus1, …)")
+    id: str | None = Field(None, description="name of the bus in later calls (default: the bus kind, e.g. sim, socketcand, socketcand2, …)")
 
 
 class NodeIdentity(BaseModel):
@@ -36,7 +36,7 @@ class NodeIdentity(BaseModel):
 
 
 class BusStatus(BaseModel):
-    model_config = _example(id="bus0", spec="sim", kind="sim", connected=True, error=None, nodes=[])
+    model_config = _example(id="sim", spec="sim", kind="sim", connected=True, error=None, nodes=[])
     id: str
     spec: str
     kind: str

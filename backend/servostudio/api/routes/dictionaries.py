@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 import tempfile
 from pathlib import Path
 from typing import Annotated
@@ -136,5 +137,7 @@ async def import_dictionary(
         try:
             device = library.import_eds(eds_path, props_path)
         except (DictionaryError, LibraryError) as error:
-            raise HTTPException(status_code=422, detail=str(error)) from error
+            # Name the file as the user uploaded it, not as it was staged on the server.
+            detail = str(error).replace(f"{staging}{os.sep}", "")
+            raise HTTPException(status_code=422, detail=detail) from error
     return _summary(library, library.load(device))

@@ -102,7 +102,6 @@ class ConnectionManager:
         self.events = events or EventHub()
         self._buses: dict[str, BusConnection] = {}
         self._lock = threading.Lock()
-        self._numbers = itertools.count()
 
     def open(self, spec_text: str, bus_id: str | None = None, wait: float = 2.0) -> BusConnection:
         """Open (or re-use) the bus a spec names; waits up to ``wait`` s for the first connection."""
@@ -111,7 +110,7 @@ class ConnectionManager:
             for existing in self._buses.values():
                 if existing.spec == spec:
                     return existing
-            bus_id = bus_id or f"bus{next(self._numbers)}"
+            bus_id = bus_id or self._free_id(spec.kind)
             if bus_id in self._buses:
                 raise ValueError(f"a bus named {bus_id!r} is already open")
         opener, simulation = self._opener(spec)
@@ -126,6 +125,11 @@ class ConnectionManager:
             self._buses[bus_id] = connection
         link.start(wait)
         return connection
+
+    def _free_id(self, kind: str) -> str:
+        """A readable default name: the bus kind ("sim", "socketcand"), numbered when that name is taken."""
+        candidates = itertools.chain([kind], (f"{kind}{number}" for number in itertools.count(2)))
+        return next(name for name in candidates if name not in self._buses)
 
     def _opener(self, spec: BusSpec) -> tuple[Callable[[], can.BusABC], object | None]:
         if spec.kind != "sim":
