@@ -23,7 +23,6 @@ import os
 import subprocess
 import sys
 import tempfile
-import threading
 import time
 from pathlib import Path
 
@@ -58,29 +57,6 @@ class IdleBehaviour:
         pass
 
 
-class FinePacer:
-    """Runs the simulation against the wall clock in steps of ``step`` seconds (fine enough for 1 ms responses)."""
-
-    def __init__(self, network: SimulatedNetwork, step: float = 50e-6) -> None:  # noqa: D107
-        self.network, self.step = network, step
-        self._stop = threading.Event()
-        self._thread = threading.Thread(target=self._run, daemon=True)
-        self._thread.start()
-
-    def _run(self) -> None:
-        origin_wall, origin_virtual = time.perf_counter(), self.network.now
-        while not self._stop.is_set():
-            behind = origin_virtual + (time.perf_counter() - origin_wall) - self.network.now
-            if behind > 0:
-                self.network.advance(min(behind, 1e-4))
-            else:
-                time.sleep(self.step)
-
-    def stop(self) -> None:
-        self._stop.set()
-        self._thread.join()
-
-
 def round_trip_bound(node: int, index: int, sub: int, data: bytes) -> tuple[float, float]:
     """(chain time, bus occupancy) of reading one object whose value is ``data``."""
     request = Frame(0x600 + node, bytes([0x40, index & 0xFF, index >> 8, sub, 0, 0, 0, 0]))
@@ -113,11 +89,11 @@ def bound(per_drive: dict[int, list[tuple[int, int, bytes]]]) -> float:
 
 
 def serve_simulation(drives: int, port: int) -> None:
-    """The simulator process: idle drives on the timed bus, paced against the wall clock, behind socketcand."""
-    sys.setswitchinterval(0.0002)
+    """The simulator process: idle drives on the timed bus, run in real time by the product's own loop
+    (`SimulatedNetwork.start()`, as in `servostudio sim`), behind socketcand."""
     network = SimulatedNetwork(",".join(str(node) for node in range(1, drives + 1)),
                                behaviour_factory=lambda *args: IdleBehaviour(), bitrate=BITRATE)
-    FinePacer(network)
+    network.start()
     server = SocketcandServer(network, port=port).start()
     print(server.address[1], flush=True)
     sys.stdin.read()  # until the bench closes the pipe

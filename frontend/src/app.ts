@@ -14,8 +14,8 @@ import { applyTheme, storedTheme, toggleTheme } from "./components/theme";
 import { mountPage } from "./pages";
 import { driveApi, learnBuses } from "./drives";
 
-/** Tree states are refreshed from events; this slow refresh only catches state changes made by other masters. */
-const TREE_REFRESH_MS = 5000;
+/** Tree states come from events (`drive_state`, NMT, EMCY); only while the event socket is down are they polled. */
+const TREE_FALLBACK_MS = 10000;
 const APP_NAME = "Servo Studio";
 
 export interface Page {
@@ -106,8 +106,8 @@ export class App {
     for (const type of ["bus_state", "bus_closed", "scan", "ws_open"]) this.live.on(type, () => void this.refreshBuses());
     for (const type of ["emcy", "bootup", "heartbeat_back"]) this.live.on(type, () => void this.live.refreshAxes());
     setInterval(() => {
-      if (document.visibilityState === "visible") void this.live.refreshAxes();
-    }, TREE_REFRESH_MS);
+      if (!this.live.connected() && document.visibilityState === "visible") void this.live.refreshAxes();
+    }, TREE_FALLBACK_MS);
     this.live.start();
     this.render();
     await this.refreshProjects();

@@ -1,6 +1,6 @@
 /** The communication server's bus and drive routes (`/api/buses/…`): objects, state, faults, scan, NMT. */
 
-import { ApiError, get, post, put, request, projectAddress } from "./api";
+import { get, post, put, request, projectAddress } from "./api";
 import type { Scalar } from "./lib/od";
 
 const e = encodeURIComponent;
@@ -111,27 +111,11 @@ export function serverBus(bus: string): string {
 }
 
 const nodePath = (bus: string, node: number) => `/api/buses/${e(serverBus(bus))}/nodes/${node}`;
-const scans = new Map<string, Promise<unknown>>();
 
-/**
- * Node routes need to know the node's device; the server learns it by a scan. When it answers that it knows no
- * dictionary for the node, scan the bus once (shared by concurrent callers) and try again.
- */
-async function withScan<T>(bus: string, work: () => Promise<T>): Promise<T> {
+/** Drive calls wait until the bus mapping is known; the server identifies a node on first use (no scan needed). */
+async function whenMapped<T>(work: () => Promise<T>): Promise<T> {
   await aliasesKnown;
-  try {
-    return await work();
-  } catch (error) {
-    if (!(error instanceof ApiError) || !/no object dictionary known/.test(error.message)) throw error;
-    const id = serverBus(bus);
-    let scan = scans.get(id);
-    if (!scan) {
-      scan = post(`/api/buses/${e(id)}/scan`).finally(() => scans.delete(id));
-      scans.set(id, scan);
-    }
-    await scan;
-    return work();
-  }
+  return work();
 }
 
 export const driveApi = {
@@ -143,16 +127,11 @@ export const driveApi = {
   nmt: (bus: string, command: string, node = 0) =>
     aliasesKnown.then(() => post<void>(`/api/buses/${e(serverBus(bus))}/nmt`, { command, node })),
 
-  read: (bus: string, node: number, key: string) => withScan(bus, () => get<ObjectValue>(`${nodePath(bus, node)}/objects/${e(key)}`)),
+  read: (bus: string, node: number, key: string) => whenMapped(() => get<ObjectValue>(`${nodePath(bus, node)}/objects/${e(key)}`)),
   writeKey: (bus: string, node: number, key: string, value: number | string, physical = false) =>
-    withScan(bus, () => put<ObjectValue>(`${nodePath(bus, node)}/objects/${e(key)}`, { value, physical })),
+    whenMapped(() => put<ObjectValue>(`${nodePath(bus, node)}/objects/${e(key)}`, { value, physical })),
   readKeys: (bus: string, node: number, keys: string[], signal?: AbortSignal) =>
-    withScan(bus, async () => {
-      const rows = await request<ReadResult[]>("POST", `${nodePath(bus, node)}/read`, { objects: keys }, fetch, signal);
-      const unknown = rows.find((row) => row.error && /no object dictionary known/.test(row.error));
-      if (unknown) throw new ApiError(422, unknown.error!);
-      return rows;
-    }),
+    whenMapped(() => request<ReadResult[]>("POST", `${nodePath(bus, node)}/read`, { objects: keys }, fetch, signal)),
 
   /** Read many (index, sub) in batches of the server's limit; a failing object carries its error. */
   async readMany(bus: string, node: number, keys: [number, number][], signal?: AbortSignal): Promise<ReadValue[]> {
@@ -174,10 +153,10 @@ export const driveApi = {
     return value.raw;
   },
 
-  state: (bus: string, node: number) => withScan(bus, () => get<DriveStateInfo>(`${nodePath(bus, node)}/state`)),
+  state: (bus: string, node: number) => whenMapped(() => get<DriveStateInfo>(`${nodePath(bus, node)}/state`)),
   setState: (bus: string, node: number, target: string) =>
-    withScan(bus, () => put<DriveStateInfo>(`${nodePath(bus, node)}/state`, { target })),
-  faults: (bus: string, node: number) => withScan(bus, () => get<FaultReport>(`${nodePath(bus, node)}/faults`)),
-  resetFaults: (bus: string, node: number) => withScan(bus, () => post<FaultReport>(`${nodePath(bus, node)}/faults/reset`)),
+    whenMapped(() => put<DriveStateInfo>(`${nodePath(bus, node)}/state`, { target })),
+  faults: (bus: string, node: number) => whenMapped(() => get<FaultReport>(`${nodePath(bus, node)}/faults`)),
+  resetFaults: (bus: string, node: number) => whenMapped(() => post<FaultReport>(`${nodePath(bus, node)}/faults/reset`)),
   fileUrl: (bus: string, node: number, name: string) => `${nodePath(bus, node)}/files/${e(name)}`,
 };

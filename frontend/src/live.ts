@@ -1,6 +1,8 @@
 /**
  * Live state of buses and axes, fed by the server's event WebSocket (`/api/ws/events`). Pages subscribe to the
  * event types they show; the hub keeps the last known state of each axis for the project tree and the top bar.
+ * While the socket is open the server watches the known drives' status words and sends `drive_state` on every
+ * change, so axis states need no polling.
  */
 
 import type { AxisConfig } from "./api";
@@ -53,9 +55,15 @@ export class LiveHub {
   private readonly busStates = new Map<string, string>();
   private currentUser: UserInfo | null = null;
   private watched: AxisConfig[] = [];
+  private socketOpen = false;
 
   start(): void {
     this.connect();
+  }
+
+  /** Whether the event socket is open: axis states and job ends then arrive as events, no polling needed. */
+  connected(): boolean {
+    return this.socketOpen;
   }
 
   /** Subscribe to one event type ("*" for all); returns the unsubscribe function. */
@@ -130,6 +138,7 @@ export class LiveHub {
     const protocol = window.location.protocol === "https:" ? "wss:" : "ws:";
     const socket = new WebSocket(`${protocol}//${window.location.host}/api/ws/events`);
     socket.addEventListener("open", () => {
+      this.socketOpen = true;
       void this.refreshAxes();
       this.emit({ type: "ws_open" });
     });
@@ -140,7 +149,10 @@ export class LiveHub {
         // A frame that is not JSON is not an event.
       }
     });
-    socket.addEventListener("close", () => setTimeout(() => this.connect(), RECONNECT_MS));
+    socket.addEventListener("close", () => {
+      this.socketOpen = false;
+      setTimeout(() => this.connect(), RECONNECT_MS);
+    });
   }
 
   emit(event: LiveEvent): void {

@@ -176,54 +176,21 @@ def slow():
     return slow_drives
 
 
-class Pacer:
-    """Runs a SimulatedNetwork against the wall clock in 1 ms steps, releasing its lock between steps.
-
-    On a loaded host the simulation runs slower than real time; small steps keep a frame from outside waiting at
-    most one step for the lock, so SDO latency stays a few milliseconds instead of a whole catch-up batch.
-    """
-
-    STEP = 0.00025
-    MAX_LAG = 0.05
-
-    def __init__(self, network) -> None:
-        self.network = network
-        self._stop = threading.Event()
-        self._thread = threading.Thread(target=self._run, name="sim-pacer", daemon=True)
-        self._thread.start()
-
-    def _run(self) -> None:
-        import time
-
-        origin_wall, origin_virtual = time.monotonic(), self.network.now
-        while not self._stop.is_set():
-            behind = origin_virtual + (time.monotonic() - origin_wall) - self.network.now
-            if behind <= 0:
-                time.sleep(self.STEP / 2)
-                continue
-            self.network.advance(min(behind, self.STEP))
-            if behind > self.MAX_LAG:
-                origin_wall += behind - self.MAX_LAG  # slip instead of catching up in a burst
-
-    def stop(self) -> None:
-        self._stop.set()
-        self._thread.join()
-
-
 @pytest.fixture(scope="module")
 def sim_network(tmp_path_factory):
-    """Three simulated XtrapulsPac drives (nodes 1, 2, 3), paced against the wall clock, one per test module.
+    """Three simulated XtrapulsPac drives (nodes 1, 2, 3) in real time (`SimulatedNetwork.start()`), one per test
+    module.
 
     Tests do not rely on values another test of the module may have changed: each sets or reads back what it
-    checks.  (Module scope, not session: the pacer would otherwise take CPU from every later module.)
+    checks.  (Module scope, not session: the running simulation would otherwise take CPU from every later module.)
     """
     from servostudio.sim.network import SimulatedNetwork
 
     network = SimulatedNetwork("1,2,3", state_dir=tmp_path_factory.mktemp("sim-flash"),
                                sdo_response_time=FAST_SDO_RESPONSE)
-    pacer = Pacer(network)
+    network.start()
     yield network
-    pacer.stop()
+    network.stop()
 
 
 class Socketcand:
@@ -270,11 +237,11 @@ def manager():
 
 
 def _commission(drive) -> None:
-    """Give in-range values to saved objects the simulated drive starts outside their range.
+    """Give in-range values to saved objects a drive holds outside their range, and a text to empty names.
 
-    A few objects of the built-in EDS have a LowLimit above 0 but no DefaultValue, so a fresh simulated drive
-    holds 0 there, and a restore (which validates against the dictionary) would rightly refuse its backup.
-    Empty names get a text too: the simulated flash cannot store empty text in its DRIVEPAR.TXT.
+    A fresh simulated drive holds only in-range values (docs/simulator.md, factory values), so the first part
+    changes nothing there; empty names get a text so that a backup holds every object (the object file cannot
+    carry an empty text, and a backup leaves such objects out).
     """
     variables = [var for kind in (FileKind.DRIVEPAR, FileKind.USER_PAR)
                  for var in backup_objects(drive, kind.save_type)]

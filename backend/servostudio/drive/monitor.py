@@ -1,7 +1,9 @@
 """Bus monitor: EMCY, boot-up and heartbeat frames → events (decoded faults, NMT state changes, heartbeat loss).
 
 CiA 402 state changes: when a scan found a TPDO carrying the status word first (``watch_statusword``), every such
-PDO is decoded and a change of state is reported — passively, without polling the drive.
+PDO is decoded and a change of state is reported — passively, without polling the drive.  Status words read by
+other means (state control, the services' slow status word watch) come in through ``report_statusword``; whatever
+the source, one ``drive_state`` event per change of state.
 
 Heartbeat loss: once a node has sent two heartbeats, its period is known; silence for more than
 ``LOSS_FACTOR`` periods (at least ``MIN_LOSS_TIME``) is reported once, and the next heartbeat reports it back.
@@ -74,8 +76,10 @@ class BusMonitor:
         """A status word read by other means (state control): reported if the state changed."""
         state = decode_state(statusword)
         name = state.value if state else None
-        if self._drive_state.get(node, "unknown") != name:
+        with self._lock:  # reader thread and request threads report concurrently: one event per change
+            changed = self._drive_state.get(node, "unknown") != name
             self._drive_state[node] = name
+        if changed:
             self._emit({"type": "drive_state", "node": node, "state": name, "statusword": statusword})
 
     def _on_statusword_pdo(self, cob_id: int, data: bytes, timestamp: float) -> None:

@@ -106,6 +106,7 @@ class SdoEngine:
         self._lock = threading.RLock()  # futures' callbacks may submit the next transfer
         self._queues: dict[int, deque[_Transfer]] = {}
         self._active: dict[int, _Transfer] = {}
+        self._finished: deque[tuple[_Transfer, object]] = deque()  # outcomes to hand over once the lock is free
         link.add_ticker(self._check_timeouts)
         link.on_state(self._link_state)
 
@@ -140,6 +141,7 @@ class SdoEngine:
             start = transfer.node not in self._active
             if start:
                 self._start_next(transfer.node)
+        self._hand_over()
         return transfer.future
 
     def _start_next(self, node: int) -> None:
@@ -147,8 +149,8 @@ class SdoEngine:
         queue = self._queues[node]
         while queue:
             transfer = queue.popleft()
-            if transfer.future.cancelled():
-                continue
+            if not transfer.future.set_running_or_notify_cancel():  # from now on cancel() refuses: the
+                continue                                            # transfer's outcome is always known
             self._active[node] = transfer
             if self._send(transfer, self._initiate(transfer)):
                 return
@@ -185,12 +187,12 @@ class SdoEngine:
                 follow_up = self._advance(transfer, data)
             except SdoError as error:
                 self._finish(transfer, error)
-                self._start_next(node)
-                return
+                follow_up = None
             if follow_up is None:
                 self._start_next(node)
             elif not self._send(transfer, follow_up):
                 self._start_next(node)
+        self._hand_over()
 
     def _advance(self, transfer: _Transfer, data: bytes) -> bytes | None:
         """Process one response; return the next request, or None when the transfer is finished."""
@@ -258,9 +260,23 @@ class SdoEngine:
             pass
 
     def _finish(self, transfer: _Transfer, outcome: object) -> None:
-        """Complete the active transfer of its node (lock held)."""
+        """End the active transfer of its node (lock held); its future completes in `_hand_over`, after the node's
+        next request has left and the lock is released (conversion and the caller's callbacks then delay neither)."""
         if self._active.get(transfer.node) is transfer:
             del self._active[transfer.node]
+        self._finished.append((transfer, outcome))
+
+    def _hand_over(self) -> None:
+        """Complete the futures of finished transfers (lock not held)."""
+        while self._finished:
+            try:
+                transfer, outcome = self._finished.popleft()
+            except IndexError:  # another thread took the last one
+                return
+            self._complete(transfer, outcome)
+
+    @staticmethod
+    def _complete(transfer: _Transfer, outcome: object) -> None:
         if transfer.future.done():
             return
         if not isinstance(outcome, Exception) and transfer.convert is not None:
@@ -290,6 +306,7 @@ class SdoEngine:
                     transfer.node, transfer.index, transfer.sub,
                     f"no SDO response within {transfer.timeout * 1000:.0f} ms on bus {self.link.name}{sent}"))
                 self._start_next(transfer.node)
+        self._hand_over()
 
     def _link_state(self, connected: bool, reason: str) -> None:
         if connected:

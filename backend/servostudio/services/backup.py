@@ -33,6 +33,7 @@ from servostudio.formats.objectfile import ObjectEntry, ObjectFileError, read_ob
 from servostudio.formats.sequence import SequenceFileError, SequenceTable, read_sequence_file, write_sequence_file
 from servostudio.od.datatypes import DataType
 from servostudio.od.model import SaveType, Variable
+from servostudio.services.cancel import Cancellation, Cancelled
 
 Progress = Callable[[dict[str, object]], None]
 SAVE_TIMEOUT = 10.0
@@ -97,6 +98,7 @@ class RestoreResult:
     stored: str = ""
     error: str = ""
     seconds: float = 0.0
+    cancelled: bool = False
 
     @property
     def ok(self) -> bool:
@@ -108,6 +110,7 @@ class RestoreResult:
             counts[outcome.status] = counts.get(outcome.status, 0) + 1
         return {"node": self.node, "file": self.file, "kind": self.kind, "ok": self.ok, "counts": counts,
                 "stored": self.stored, "error": self.error or None, "seconds": round(self.seconds, 3),
+                "cancelled": self.cancelled,
                 "objects": [outcome.__dict__ for outcome in self.outcomes if outcome.status != "verified"]}
 
 
@@ -122,16 +125,19 @@ def backup_objects(drive: Drive, save_type: SaveType) -> list[Variable]:
 
 
 def backup_file(drive: Drive, path: Path, kind: FileKind | None = None,
-                progress: Progress | None = None) -> BackupResult:
-    """Back up one file of one drive; the file is written atomically at the end."""
+                progress: Progress | None = None, cancel: Cancellation | None = None) -> BackupResult:
+    """Back up one file of one drive; the file is written atomically at the end (not at all when cancelled:
+    raises Cancelled)."""
     kind = kind or FileKind.from_path(path)
     started = time.monotonic()
+    if cancel is not None:
+        cancel.check(f"{kind.value} of node {drive.node} was read")
     if kind is FileKind.SEQUENCE:
         table = _read_sequences(drive, progress)
         write_sequence_file(path, table, header=_header(drive, kind))
         return BackupResult(drive.node, str(path), kind.value, len(table), seconds=time.monotonic() - started)
     variables = backup_objects(drive, kind.save_type)
-    values, skipped = _read_all(drive, variables, kind, progress)
+    values, skipped = _read_all(drive, variables, kind, progress, cancel)
     entries = []
     for value in values:
         file_value = _file_value(value)
@@ -145,10 +151,12 @@ def backup_file(drive: Drive, path: Path, kind: FileKind | None = None,
 
 
 def _read_all(drive: Drive, variables: list[Variable], kind: FileKind, progress: Progress | None,
-              ) -> tuple[list[ObjectValue], list[dict[str, str]]]:
+              cancel: Cancellation | None = None) -> tuple[list[ObjectValue], list[dict[str, str]]]:
     futures = [(var, drive.submit_read(var)) for var in variables]  # all queued: the engine pipelines them
     reporter = _Reporter(progress, "backup", drive.node, kind.value, len(futures))
-    _wait_all([future for _, future in futures], reporter)
+    _wait_all([future for _, future in futures], reporter, cancel)
+    if cancel is not None and cancel.requested:
+        raise Cancelled(f"backup of node {drive.node} ({kind.value}) cancelled, no file written")
     values, skipped = [], []
     for var, future in futures:
         try:
@@ -163,15 +171,18 @@ def _read_all(drive: Drive, variables: list[Variable], kind: FileKind, progress:
     return values, skipped
 
 
-def _wait_all(futures: list[Future], reporter: _Reporter) -> None:
-    """Wait once for all transfers, counting progress as they complete.
+def _wait_all(futures: list[Future], reporter: _Reporter, cancel: Cancellation | None = None) -> None:
+    """Wait once for all transfers, counting progress as they complete; a cancellation drops those not started.
 
     Waiting on each future in turn would wake this thread once per object, competing with the bus reader for
     the interpreter on every answer; here only the reader thread runs until the last answer.
     """
     for future in futures:
         future.add_done_callback(reporter.step_done)
+    forget = cancel.on_cancel(lambda: _cancel(futures)) if cancel is not None else None
     wait(futures)
+    if forget is not None:
+        forget()
 
 
 def _file_value(value: ObjectValue) -> int | str:
@@ -197,10 +208,18 @@ def _header(drive: Drive, kind: FileKind) -> str:
 
 
 def backup_drive(drive: Drive, directory: Path, kinds: Iterable[FileKind] | None = None,
-                 progress: Progress | None = None) -> list[BackupResult]:
-    """All backup files of a drive into ``directory`` (the profile's parameter files, plus SEQUENCE.TXT)."""
+                 progress: Progress | None = None, cancel: Cancellation | None = None) -> list[BackupResult]:
+    """All backup files of a drive into ``directory`` (the profile's parameter files, plus SEQUENCE.TXT).
+
+    When cancelled, the files completed so far are returned (``cancel.requested`` tells the caller)."""
     directory.mkdir(parents=True, exist_ok=True)
-    return [backup_file(drive, directory / kind.value, kind, progress) for kind in (kinds or drive_file_kinds(drive))]
+    results = []
+    for kind in kinds or drive_file_kinds(drive):
+        try:
+            results.append(backup_file(drive, directory / kind.value, kind, progress, cancel))
+        except Cancelled:
+            break
+    return results
 
 
 def drive_file_kinds(drive: Drive) -> list[FileKind]:
@@ -259,8 +278,11 @@ def _entry_value(variable: Variable, value: int | str) -> int | float | str:
 
 
 def restore_file(drive: Drive, path: Path, kind: FileKind | None = None, progress: Progress | None = None,
-                 store: bool = True) -> RestoreResult:
-    """Validate, write, verify and store one file to one drive."""
+                 store: bool = True, cancel: Cancellation | None = None) -> RestoreResult:
+    """Validate, write, verify and store one file to one drive.
+
+    A cancellation drops the writes not yet sent: the result lists which objects were written (not verified, not
+    stored).  A sequence file is written whole once started (half a sequence memory is worth nothing)."""
     kind = kind or FileKind.from_path(path)
     started = time.monotonic()
     result = RestoreResult(drive.node, str(path), kind.value)
@@ -269,17 +291,24 @@ def restore_file(drive: Drive, path: Path, kind: FileKind | None = None, progres
     else:
         writes = [(var, _entry_value(var, entry.value)) for entry, var, _ in validate_object_file(drive, path)]
     _check_can_store(drive, store)
+    if cancel is not None and cancel.requested:
+        result.outcomes = [ObjectOutcome(var.label, _shown(value), "not written") for var, value in writes]
+        result.error, result.cancelled = (f"restore of node {drive.node} cancelled: 0 of {len(writes)} objects were "
+                                          "written; nothing was stored to flash"), True
+        return result
     try:
         if kind is FileKind.SEQUENCE:
             result.outcomes = _write_sequences(drive, table, writes, progress)
         else:
-            _write_and_verify(drive, writes, kind, progress, result.outcomes)
+            _write_and_verify(drive, writes, kind, progress, result.outcomes, cancel)
         if store and all(outcome.status == "verified" for outcome in result.outcomes):
             procedure = "save_sequences" if kind is FileKind.SEQUENCE else "save"
             drive.start_procedure(procedure, timeout=SAVE_TIMEOUT)
             result.stored = procedure
     except (SdoError, BackupError) as error:
         result.error = str(error)
+    except Cancelled as error:
+        result.error, result.cancelled = str(error), True
     result.seconds = time.monotonic() - started
     return result
 
@@ -293,7 +322,8 @@ def _check_can_store(drive: Drive, store: bool) -> None:
 
 
 def _write_and_verify(drive: Drive, writes: list[tuple[Variable, object]], kind: FileKind,
-                      progress: Progress | None, report: list[ObjectOutcome]) -> None:
+                      progress: Progress | None, report: list[ObjectOutcome],
+                      cancel: Cancellation | None = None) -> None:
     """Write all, read all back; rewrite what a later write changed (side effects), read back once more.
 
     ``report`` receives one outcome per object up front and is updated as answers arrive, so after a failure it
@@ -306,9 +336,11 @@ def _write_and_verify(drive: Drive, writes: list[tuple[Variable, object]], kind:
     pending = list(range(len(writes)))
     for _ in range(2):  # one rewrite pass for values that a later write changed
         write_futures = [(index, drive.submit_write(writes[index][0], writes[index][1])) for index in pending]
-        _wait_all([future for _, future in write_futures], reporter)
+        _wait_all([future for _, future in write_futures], reporter, cancel)
         link_error: SdoError | None = None
         for index, future in write_futures:
+            if future.cancelled():
+                continue  # dropped by a cancellation before it was sent: stays "not written"
             try:
                 future.result()
                 outcomes[index].status, outcomes[index].error = "written", ""
@@ -319,12 +351,16 @@ def _write_and_verify(drive: Drive, writes: list[tuple[Variable, object]], kind:
         if link_error is not None:
             raise_with = _partial(drive, outcomes, link_error)
             raise raise_with
+        if cancel is not None and cancel.requested:
+            raise _cancelled(drive, outcomes)
         readable = [index for index in pending if outcomes[index].status == "written"
                     and writes[index][0].access.readable]
         read_futures = [(index, drive.submit_read(writes[index][0])) for index in readable]
-        _wait_all([future for _, future in read_futures], reporter)
+        _wait_all([future for _, future in read_futures], reporter, cancel)
         mismatched = []
         for index, future in read_futures:
+            if future.cancelled():
+                continue
             try:
                 value = future.result().raw
             except SdoError as error:
@@ -337,6 +373,8 @@ def _write_and_verify(drive: Drive, writes: list[tuple[Variable, object]], kind:
             else:
                 outcomes[index].status, outcomes[index].error = "failed", f"read back {_shown(value)}"
                 mismatched.append(index)
+        if cancel is not None and cancel.requested:
+            raise _cancelled(drive, outcomes)
         for index in pending:
             if outcomes[index].status == "written":  # write-only objects cannot be read back
                 outcomes[index].status = "verified"
@@ -349,6 +387,13 @@ def _partial(drive: Drive, outcomes: dict[int, ObjectOutcome], error: SdoError) 
     written = [outcome.label for outcome in outcomes.values() if outcome.status in ("written", "verified")]
     return BackupError(f"restore of node {drive.node} stopped: {error}. {len(written)} of {len(outcomes)} objects "
                        "had been written; nothing was stored to flash. Run the restore again once the link is back.")
+
+
+def _cancelled(drive: Drive, outcomes: dict[int, ObjectOutcome]) -> Cancelled:
+    sent = [outcome for outcome in outcomes.values() if outcome.status != "not written"]
+    refused = [outcome for outcome in sent if outcome.status == "failed" and not outcome.error.startswith("read back")]
+    return Cancelled(f"restore of node {drive.node} cancelled: {len(sent) - len(refused)} of {len(outcomes)} "
+                     f"objects were written ({len(refused)} refused, the rest not sent); nothing was stored to flash")
 
 
 def _same(read: object, written: object) -> bool:

@@ -18,6 +18,7 @@ text the format cannot carry (empty, or with leading/trailing spaces) is left ou
 
 from __future__ import annotations
 
+import logging
 import struct
 from collections.abc import Callable
 from pathlib import Path
@@ -31,9 +32,12 @@ from servostudio.od.datatypes import DataType
 from servostudio.od.model import SaveType, Value, Variable
 from servostudio.sim.clock import VirtualClock
 from servostudio.sim.events import DriveEvents
+from servostudio.sim import sdo_abort
 from servostudio.sim.objects import ObjectStore, check_range
 from servostudio.sim.sdo_abort import SdoAbort
 from servostudio.sim.sequences import SequenceMemory
+
+log = logging.getLogger(__name__)
 
 STORE_PARAMETERS = 0x1010
 RESTORE_PARAMETERS = 0x1011
@@ -183,7 +187,14 @@ class FlashFiles:
             return  # decisions.md §4: any other value is ignored
         self._status[index] = ProcedureStatus.RUNNING
         self.events.flash_busy = True
-        ok = operation()
+        try:
+            ok = operation()
+        except Exception as exc:  # the flash itself failed (state directory not writable, …): answer, never hang
+            log.exception("flash operation 0x%08X on node %d failed", int(value), self.store.node_id)
+            self.last_error = f"flash operation failed: {exc}"
+            self._status[index] = ProcedureStatus.ERROR
+            self.events.flash_busy = self.clock.now < self._busy_until
+            raise SdoAbort(sdo_abort.CANNOT_TRANSFER, self.last_error) from exc
         self._busy_until = self.clock.now + OPERATION_TIME
         self.clock.call_at(self._busy_until, lambda: self._finish(index, ok))
 

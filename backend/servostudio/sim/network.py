@@ -2,10 +2,13 @@
 
 Two ways to run time:
 - tests call `advance(seconds)`: deterministic, as fast as the host allows;
-- servers call `start()`: a background thread paces virtual time against the monotonic wall clock (events due are
-  run in batches about every millisecond). When the host cannot keep up for more than `MAX_LAG` seconds, virtual
-  time slips (it runs slower than the wall clock) instead of trying to catch up in a burst.
-All access to the simulation goes through `lock`; frames from outside enter with `inject`.
+- servers call `start()`: a background thread paces virtual time against the monotonic wall clock. It runs the
+  events due in chunks of at most `CHUNK` virtual seconds, taking `lock` for one chunk at a time, and sleeps until
+  the next event is due (or a client's frame arrives). When the host cannot keep up, virtual time stays at most
+  `MAX_LAG` behind the wall clock: it slips (runs slower than real time) instead of catching up in a burst.
+All access to the simulation goes through `lock`. Frames and actions from other threads enter with `inject` /
+`post`: while the thread runs they wait in a queue that it empties after every chunk, so a client's frame never
+waits for the lock behind a catch-up and enters the bus at the simulation's present.
 """
 
 from __future__ import annotations
@@ -13,6 +16,7 @@ from __future__ import annotations
 import logging
 import threading
 import time
+from collections import deque
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass
 from pathlib import Path
@@ -30,7 +34,10 @@ from servostudio.sim.sdo_server import DEFAULT_RESPONSE_TIME
 log = logging.getLogger(__name__)
 
 DEFAULT_DEVICE = "xtrapulspac"
-PACING_INTERVAL = 1e-3
+CHUNK = CONTROL_PERIOD
+"""Virtual seconds the real-time thread runs per lock hold; frames from clients enter between chunks."""
+IDLE_WAIT = 1e-3
+"""Longest sleep of the real-time thread when no event is due (a posted frame wakes it at once)."""
 MAX_LAG = 0.05
 
 DeviceBehaviourFactory = Callable[[str, int, ObjectStore, DriveEvents], Behaviour]
@@ -128,6 +135,8 @@ class SimulatedNetwork:
         self.clock.call_at(CONTROL_PERIOD, self._tick)
         self._thread: threading.Thread | None = None
         self._stop = threading.Event()
+        self._wake = threading.Event()
+        self._posted: deque[Callable[[], None]] = deque()
 
     # -- nodes ----------------------------------------------------------------------------------------------------
 
@@ -151,6 +160,7 @@ class SimulatedNetwork:
         if self.running:
             raise RuntimeError("advance() cannot step a network whose real-time thread is running")
         with self.lock:
+            self._run_posted()
             self.clock.run_until(self.clock.now + seconds)
 
     @property
@@ -171,23 +181,46 @@ class SimulatedNetwork:
 
     def stop(self) -> None:
         self._stop.set()
+        self._wake.set()
         if self._thread is not None:
             self._thread.join()
             self._thread = None
+        with self.lock:
+            self._run_posted()  # frames that arrived while the thread was ending
 
     def _run(self) -> None:
         origin_wall = time.monotonic()
         origin_virtual = self.clock.now
-        while not self._stop.wait(PACING_INTERVAL):
+        while not self._stop.is_set():
             target = origin_virtual + (time.monotonic() - origin_wall)
             with self.lock:
-                try:
-                    self.clock.run_until(min(target, self.clock.now + MAX_LAG))
-                except Exception:  # keep serving the other drives and clients; the failed event is dropped
-                    log.exception("simulation event failed at t=%.6f s", self.clock.now)
+                self._run_chunk(min(target, self.clock.now + CHUNK))
                 behind = target - self.clock.now
+                due = self.clock.next_event_time()
             if behind > MAX_LAG:
-                origin_wall += behind  # slip: the host is too slow, virtual time runs slower than real time
+                origin_wall += behind - MAX_LAG  # slip: the host is too slow, virtual time runs slower than real time
+            if behind > 0:
+                time.sleep(0)  # let the socket threads take the interpreter between chunks
+            else:
+                self._wake.wait(IDLE_WAIT if due is None else min(IDLE_WAIT, due - self.clock.now))
+                self._wake.clear()
+
+    def _run_chunk(self, until: float) -> None:
+        """Events due up to `until`, then the frames posted meanwhile (lock held); a failing event is dropped."""
+        try:
+            self.clock.run_until(until)
+        except Exception:  # keep serving the other drives and clients; the failed event is dropped
+            log.exception("simulation event failed at t=%.6f s", self.clock.now)
+        self._run_posted()
+
+    def _run_posted(self) -> None:
+        posted = self._posted
+        while posted:
+            action = posted.popleft()
+            try:
+                action()
+            except Exception:
+                log.exception("action posted from outside failed at t=%.6f s", self.clock.now)
 
     def __enter__(self) -> "SimulatedNetwork":
         return self
@@ -207,8 +240,18 @@ class SimulatedNetwork:
 
     def inject(self, frame: Frame, sender: Station | None = None) -> None:
         """Put a frame from outside (client, socketcand, serial) on the bus at the current virtual time."""
+        self.post(lambda: self.bus.transmit(frame, sender))
+
+    def post(self, action: Callable[[], None]) -> None:
+        """Run `action` inside the simulation: while running, on its thread after the current chunk (the caller does
+        not wait for the lock); otherwise at once, under the lock."""
+        if self.running:
+            self._posted.append(action)
+            self._wake.set()
+            return
         with self.lock:
-            self.bus.transmit(frame, sender)
+            self._run_posted()
+            action()
 
     def open_bus(self, channel: str = "sim", **kwargs: object):
         """A python-can bus attached to this network (e.g. `canopen.Network(network.open_bus())`)."""

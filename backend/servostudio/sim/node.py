@@ -131,6 +131,7 @@ class SimulatedNode:
 
     def _register_hooks(self) -> None:
         store = self.store
+        self._read_sync_cob_id = store.reader(SYNC_COB_ID, 0) if (SYNC_COB_ID, 0) in store else (lambda: 0x80)
         if (START_REMOTE_NODES, 0) in store:
             store.on_write(START_REMOTE_NODES, 0, self._start_remote_nodes)
         for index in (SYNC_COB_ID, SYNC_PERIOD):
@@ -193,7 +194,8 @@ class SimulatedNode:
     # -- SYNC -----------------------------------------------------------------------------------------------------
 
     def _sync_id(self) -> int:
-        return self._value(SYNC_COB_ID, 0, 0x80) & 0x7FF
+        """0x1005 bits 0–10 (read for every frame on the bus, so without the checked access)."""
+        return self._read_sync_cob_id() & 0x7FF
 
     def _on_sync(self) -> None:
         self.behaviour.on_sync()

@@ -23,7 +23,7 @@ _FIRST_SDO_ACCESSIBLE = 0x1000  # 0x0001–0x0FFF are data type definitions / du
 
 
 def zero_value(data_type: DataType) -> Value:
-    """The value of an object whose dictionary entry has no default."""
+    """Zero of a type: the empty text, no bytes, 0.0 or 0."""
     if data_type.is_text:
         return ""
     if data_type.is_binary:
@@ -31,6 +31,20 @@ def zero_value(data_type: DataType) -> Value:
     if data_type.is_float:
         return 0.0
     return 0
+
+
+def undefined_default(var: Variable) -> Value:
+    """What a new drive holds in an object whose dictionary entry has no DefaultValue: zero, or the limit nearest
+    to it when zero is outside LowLimit..HighLimit (a drive never holds a value it would refuse on the bus, so a
+    backup of a fresh drive restores)."""
+    value = zero_value(var.data_type)
+    if not var.data_type.is_numeric:
+        return value
+    if var.minimum is not None and value < var.minimum:
+        return var.minimum
+    if var.maximum is not None and value > var.maximum:
+        return var.maximum
+    return value
 
 
 class ObjectStore:
@@ -42,15 +56,29 @@ class ObjectStore:
         self._values: dict[tuple[int, int], Value] = {}
         self._write_hooks: dict[tuple[int, int | None], list[WriteHook]] = {}
         self._read_hooks: dict[tuple[int, int | None], list[ReadHook]] = {}
+        self._hardware: dict[tuple[int, int], Value] = {}
         self.restore_defaults()
 
     def restore_defaults(self, indices: Iterable[int] | None = None) -> None:
-        """Put the dictionary defaults back (all objects, or those whose index is in `indices`)."""
+        """Put the factory values back (all objects, or those whose index is in `indices`)."""
         wanted = None if indices is None else set(indices)
         for var in self.od.variables():
             if wanted is None or var.index in wanted:
-                default = var.default_for(self.node_id)
-                self._values[var.key] = zero_value(var.data_type) if default is None else default
+                self._values[var.key] = self.factory_value(var)
+
+    def factory_value(self, var: Variable) -> Value:
+        """A new drive's value: the hardware's own (`set_factory`), else the dictionary default, else
+        `undefined_default`."""
+        if var.key in self._hardware:
+            return self._hardware[var.key]
+        default = var.default_for(self.node_id)
+        return undefined_default(var) if default is None else default
+
+    def set_factory(self, index: int, sub: int, value: Value) -> None:
+        """A factory value the dictionary cannot know (ratings, node ID switches): stored now and after every
+        `restore_defaults`."""
+        self.set(index, sub, value)
+        self._hardware[(index, sub)] = value
 
     # -- internal access (drive model) ---------------------------------------------------------------------------
 

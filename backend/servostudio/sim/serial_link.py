@@ -84,14 +84,17 @@ class SerialGateway:
             self._writers.remove(writer)
 
     def host_frames(self, frames: list[tuple[int, bytes]]) -> None:
-        """Frames decoded from the host's bytes (called from an endpoint thread)."""
-        with self.network.lock:
-            for cob_id, data in frames:
-                frame = Frame(cob_id, data)
-                if self.node.handle_local(frame, self._to_host):
-                    continue
-                if cob_id in FORWARDED:
-                    self.network.bus.transmit(frame, sender=self)
+        """Frames decoded from the host's bytes (called from an endpoint thread; they enter the simulation like a
+        client's CAN frames, between two chunks of simulated time)."""
+        self.network.post(lambda: self._host_frames(frames))
+
+    def _host_frames(self, frames: list[tuple[int, bytes]]) -> None:
+        for cob_id, data in frames:
+            frame = Frame(cob_id, data)
+            if self.node.handle_local(frame, self._to_host):
+                continue
+            if cob_id in FORWARDED:
+                self.network.bus.transmit(frame, sender=self)
 
     def _to_host(self, frame: Frame) -> None:
         cob_id = frame.can_id

@@ -98,13 +98,20 @@ class SocketcandServer:
 
 
 class _Session:
-    """One client connection: a reader thread parsing commands, a writer thread draining the output queue."""
+    """One client connection: a reader thread parsing commands, a writer thread draining the output queue.
+
+    A bus frame is sent straight from the simulation thread when nothing is waiting in the queue (a non-blocking
+    send: one thread hand-over less per frame, which is most of an SDO round trip's host latency); when the socket
+    would block, or while earlier output is still queued, it goes through the queue, so the order is kept.
+    """
 
     def __init__(self, server: SocketcandServer, connection: socket.socket) -> None:
         self.server = server
         self.connection = connection
         connection.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
-        self._output: queue.SimpleQueue[str | float | None] = queue.SimpleQueue()
+        self._output: queue.SimpleQueue[bytes | float | None] = queue.SimpleQueue()
+        self._queued = 0  # items put in the output queue and not yet written (guarded by _queued_lock)
+        self._queued_lock = threading.Lock()
         self._opened = False
         self._attached = False
         self._closed = threading.Event()
@@ -112,7 +119,7 @@ class _Session:
     def start(self) -> None:
         threading.Thread(target=self._write_loop, name="socketcand-tx", daemon=True).start()
         threading.Thread(target=self._read_loop, name="socketcand-rx", daemon=True).start()
-        self._output.put("< hi >")
+        self._put("< hi >")
 
     def close(self) -> None:
         if self._closed.is_set():
@@ -131,8 +138,27 @@ class _Session:
     # -- station --------------------------------------------------------------------------------------------------
 
     def receive(self, frame: Frame, timestamp: float) -> None:
-        if self._output.qsize() < OUTPUT_QUEUE_LIMIT:
-            self._output.put(format_frame(frame, timestamp))
+        data = format_frame(frame, timestamp).encode("ascii")
+        with self._queued_lock:
+            if self._queued == 0:
+                try:
+                    data = data[self.connection.send(data, socket.MSG_DONTWAIT):]
+                except BlockingIOError:
+                    pass
+                except OSError:
+                    return  # the connection is gone; the reader thread closes the session
+                if not data:
+                    return
+            if self._queued >= OUTPUT_QUEUE_LIMIT:
+                return
+            self._queued += 1
+        self._output.put(data)
+
+    def _put(self, item: str | float) -> None:
+        """Queue a protocol answer or a pause for the writer thread."""
+        with self._queued_lock:
+            self._queued += 1
+        self._output.put(item.encode("ascii") if isinstance(item, str) else item)
 
     # -- threads --------------------------------------------------------------------------------------------------
 
@@ -141,14 +167,17 @@ class _Session:
             item = self._output.get()
             if item is None:
                 return
-            if isinstance(item, float):
-                time.sleep(item)
-                continue
             try:
-                self.connection.sendall(item.encode("ascii"))
+                if isinstance(item, float):
+                    time.sleep(item)
+                else:
+                    self.connection.sendall(item)
             except OSError:
                 self.close()
                 return
+            finally:
+                with self._queued_lock:
+                    self._queued -= 1
 
     def _read_loop(self) -> None:
         buffer = ""
@@ -180,13 +209,13 @@ class _Session:
         verb, arguments = words[0], words[1:]
         if verb == "open":
             if arguments != [self.server.channel]:
-                self._output.put(f"< error could not open bus '{' '.join(arguments)}' >")
+                self._put(f"< error could not open bus '{' '.join(arguments)}' >")
                 return
             self._opened = True
-            self._output.put("< ok >")
+            self._put("< ok >")
         elif verb == "rawmode" and self._opened:
-            self._output.put("< ok >")
-            self._output.put(SETTLE_TIME)
+            self._put("< ok >")
+            self._put(SETTLE_TIME)
             if not self._attached:
                 self._attached = True
                 self.server.network.attach(self)
@@ -194,10 +223,10 @@ class _Session:
             try:
                 frame = parse_send(arguments)
             except ValueError as exc:
-                self._output.put(f"< error {exc} >")
+                self._put(f"< error {exc} >")
                 return
             self.server.network.inject(frame, sender=self)
         elif verb == "echo":
-            self._output.put("< echo >")
+            self._put("< echo >")
         else:
-            self._output.put(f"< error unsupported command '{verb}' >")
+            self._put(f"< error unsupported command '{verb}' >")

@@ -1,11 +1,13 @@
 /**
  * Project-wide commissioning as a server job (`POST /api/projects/{p}/commission`): check every axis's drive,
  * upload the drives into the project, or download the project into the drives. Progress and the final report
- * arrive as `progress` and `job` events on `/api/ws/events`; the page shows one progress bar per axis.
+ * arrive as `progress` and `job` events on `/api/ws/events`; the page shows one progress bar per axis. Cancel asks
+ * the server to stop the job at the next object (download) or file (upload); the report then says what was done.
  */
 
 import type { App } from "../app";
 import { post } from "../api";
+import { cancelJob } from "../jobs";
 import { h, replaceChildren } from "../lib/dom";
 import type { LiveEvent } from "../live";
 import { confirmAction, errorText } from "./ui";
@@ -47,6 +49,14 @@ export function commissionPanel(app: App, project: string, onDone: () => void): 
   let job: string | null = null;
   let offProgress: (() => void) | null = null;
   let offJob: (() => void) | null = null;
+  const cancel = h("button", {
+    "data-testid": "commission-cancel", disabled: true, title: "Stop the job at the next object or file",
+    onclick: () => {
+      if (job === null) return;
+      cancel.disabled = true;
+      void cancelJob(job).catch((error) => replaceChildren(status, h("div", { class: "message error" }, errorText(error))));
+    },
+  }, "Cancel");
   const buttons = DIRECTIONS.map(([direction, label, title]) => h("button", {
     class: direction === "download" ? "danger" : "", title, "data-testid": `commission-${direction}`,
     onclick: () => void start(direction, label),
@@ -81,13 +91,16 @@ export function commissionPanel(app: App, project: string, onDone: () => void): 
     offJob?.();
     job = null;
     buttons.forEach((button) => (button.disabled = false));
+    cancel.disabled = true;
     if (info.state === "failed" || !info.result) {
       replaceChildren(status, h("div", { class: "message error", "data-testid": "commission-result" }, info.error ?? "The job failed."));
       return;
     }
     const result = info.result;
-    replaceChildren(status, h("div", { class: `message ${result.ok ? "ok" : "warn"}`, "data-testid": "commission-result" },
-      `${result.direction}: ${result.ok ? "every axis OK" : "some axes need attention"}`),
+    const summary = info.state === "cancelled" ? "cancelled; the table shows what was done"
+      : result.ok ? "every axis OK" : "some axes need attention";
+    replaceChildren(status, h("div", { class: `message ${result.ok && info.state !== "cancelled" ? "ok" : "warn"}`, "data-testid": "commission-result" },
+      `${result.direction}: ${summary}`),
     h("table", { class: "data" }, h("thead", null, h("tr", null, ["Axis", "Node", "Bus", "Status", "Files", "Problem"].map((t) => h("th", null, t)))),
       h("tbody", null, result.axes.map((axis) => h("tr", { class: axis.ok ? "" : "differs" },
         h("td", null, axis.axis), h("td", { class: "num" }, String(axis.node_id)), h("td", null, axis.bus_id ?? ""),
@@ -112,6 +125,7 @@ export function commissionPanel(app: App, project: string, onDone: () => void): 
     try {
       const started = await post<JobInfo>(`/api/projects/${encodeURIComponent(project)}/commission`, { direction });
       job = started.id;
+      cancel.disabled = false;
       replaceChildren(status, h("div", { class: "muted" }, `${label}: job ${started.id} running`));
       const early = ended.get(started.id);
       if (early) finish(early);
@@ -121,6 +135,6 @@ export function commissionPanel(app: App, project: string, onDone: () => void): 
     }
   };
 
-  replaceChildren(body, h("div", { class: "toolbar" }, buttons, h("span", { class: "muted" }, "All axes in parallel; progress per axis.")), status);
+  replaceChildren(body, h("div", { class: "toolbar" }, buttons, cancel, h("span", { class: "muted" }, "All axes in parallel; progress per axis.")), status);
   return h("section", { class: "panel" }, h("h2", null, "Commission all axes"), body);
 }

@@ -7,12 +7,22 @@
 import { projectAddress, projects, request, setParametersSkipping } from "../api";
 import { confirmAction, errorText, pickFile } from "../components/ui";
 import { driveApi } from "../drives";
+import { runJob, type JobInfo } from "../jobs";
 import { h, replaceChildren } from "../lib/dom";
 import { entries, isReadable, isWritable, type Entry } from "../lib/od";
 import { unstorableReason } from "../lib/values";
 import type { AxisContext, AxisViewPage } from "./axis";
 
 const CHUNK = 40;
+
+/** One file's restore result as the server reports it (`PUT …/files/{name}`). */
+interface RestoreAnswer {
+  ok: boolean;
+  cancelled: boolean;
+  counts: Record<string, number>;
+  error: string | null;
+  objects: { label: string; status: string; error: string }[];
+}
 /** 'save' as the U32 the drive expects at 0x1010,1 (CiA 301: little-endian ASCII). */
 const SAVE_SIGNATURE = 0x65766173;
 
@@ -34,8 +44,8 @@ export async function backupView(context: AxisContext): Promise<AxisViewPage> {
 
   /** Run `work` with a progress bar and a Cancel button; cancel stops at the next object. */
   /** What a run reports: its summary, marked as a warning when some objects were refused or unreadable. */
-  type Outcome = { text: string; warning: boolean };
-  const run = async (label: string, total: number, work: (signal: AbortSignal, step: (done: number, text?: string) => void) => Promise<Outcome>) => {
+  type Outcome = { text: string; warning: boolean; cancelled?: boolean };
+  const run = async (label: string, total: number, work: (signal: AbortSignal, step: (done: number, text?: string, newTotal?: number) => void) => Promise<Outcome>) => {
     const controller = new AbortController();
     running = controller;
     setBusy(true);
@@ -45,11 +55,16 @@ export async function backupView(context: AxisContext): Promise<AxisViewPage> {
       h("button", { "data-testid": "backup-cancel", onclick: () => controller.abort() }, "Cancel")));
     replaceChildren(result);
     try {
-      const outcome = await work(controller.signal, (done, extra) => {
+      const outcome = await work(controller.signal, (done, extra, newTotal) => {
+        if (newTotal !== undefined) {
+          total = newTotal;
+          bar.max = Math.max(1, total);
+        }
         bar.value = done;
         text.textContent = `${label}: ${done} / ${total}${extra ? ` · ${extra}` : ""}`;
       });
-      const cancelled = controller.signal.aborted;
+      // A server job may have ended before Cancel reached it: then it says it was not cancelled.
+      const cancelled = outcome.cancelled ?? controller.signal.aborted;
       replaceChildren(result, h("div", { class: `message ${cancelled || outcome.warning ? "warn" : "ok"}` }, cancelled ? `${label} cancelled. ${outcome.text}` : outcome.text));
     } catch (error) {
       replaceChildren(result, h("div", { class: "message error" }, `${label}: ${errorText(error)}`));
@@ -137,13 +152,19 @@ export async function backupView(context: AxisContext): Promise<AxisViewPage> {
     const file = await pickFile(".txt,.TXT");
     if (!file) return;
     if (!(await confirmAction(`Restore ${name}`, `Send ${file.name} to node ${node} as ${name}? It is validated first, then written, verified and stored to flash.`, "Restore", true))) return;
-    await run(`Restoring ${name}`, 1, async (_signal, step) => {
-      const answer = await request<{ ok: boolean; counts: Record<string, number>; error: string | null; objects: { label: string; status: string; error: string }[] }>(
-        "PUT", driveApi.fileUrl(bus, node, name), new Blob([await file.text()], { type: "text/plain" }));
-      step(1);
+    const text = await file.text();
+    // A server job: its progress comes as events and Cancel stops it on the server at the next object.
+    await run(`Restoring ${name}`, 1, async (signal, step) => {
+      const job = await runJob<Record<string, RestoreAnswer[]>>(context.page.app.live,
+        () => request<JobInfo<Record<string, RestoreAnswer[]>>>("PUT", `${driveApi.fileUrl(bus, node, name)}?job=true`,
+          new Blob([text], { type: "text/plain" })),
+        (event) => step(Number(event.done) || 0, String(event.file ?? ""), Number(event.total) || 1), signal);
+      const answer = job.result?.[String(node)]?.[0];
+      if (!answer) throw new Error(job.error ?? `the restore job ended ${job.state}`);
       const counts = Object.entries(answer.counts).map(([status, count]) => `${count} ${status}`).join(", ");
+      if (answer.cancelled) return { text: `${answer.error ?? ""} (${counts}).`, warning: true, cancelled: true };
       if (!answer.ok) throw new Error(`${answer.error ?? "not all objects verified"} (${counts}) ${answer.objects.slice(0, 3).map((o) => `${o.label}: ${o.error}`).join("; ")}`);
-      return { text: `${name} restored to node ${node}: ${counts}.`, warning: false };
+      return { text: `${name} restored to node ${node}: ${counts}.`, warning: false, cancelled: false };
     });
   };
 

@@ -2,11 +2,12 @@
 
 from __future__ import annotations
 
+import shutil
 import tempfile
 from pathlib import Path
 
 from fastapi import APIRouter, Body, Depends, HTTPException, status
-from fastapi.responses import PlainTextResponse
+from fastapi.responses import JSONResponse, PlainTextResponse
 
 from servostudio.api.deps import current_user, get_connections, get_jobs
 from servostudio.api.routes.comm_models import BackupRequest, JobModel, RestoreRequest
@@ -46,10 +47,10 @@ def start_backup(bus: str, request: BackupRequest, manager: ConnectionManager = 
     connection = manager.get(bus)
     nodes, kinds, directory = _nodes(connection, request.nodes), _kinds(request.files), Path(request.directory)
 
-    def work(progress) -> dict:
+    def work(progress, cancel) -> dict:
         drives = [connection.drive(node) for node in nodes]
         results = run_per_drive(drives, lambda drive: backup_drive(
-            drive, directory / f"node{drive.node}", kinds, lambda event: progress({**event, "bus": bus})))
+            drive, directory / f"node{drive.node}", kinds, lambda event: progress({**event, "bus": bus}), cancel))
         return _per_node(results)
 
     return jobs.start("backup", work).as_dict()
@@ -62,12 +63,17 @@ def start_restore(bus: str, request: RestoreRequest, manager: ConnectionManager 
     connection = manager.get(bus)
     nodes, kinds, directory = _nodes(connection, request.nodes), _kinds(request.files), Path(request.directory)
 
-    def work(progress) -> dict:
+    def work(progress, cancel) -> dict:
         def restore_one(drive):
             folder = directory / f"node{drive.node}"
             chosen = kinds or [kind for kind in drive_file_kinds(drive) if (folder / kind.value).is_file()]
-            return [restore_file(drive, folder / kind.value, kind, lambda event: progress({**event, "bus": bus}),
-                                 request.store) for kind in chosen]
+            results = []
+            for kind in chosen:
+                if cancel.requested:  # files not started are left out of the result
+                    break
+                results.append(restore_file(drive, folder / kind.value, kind,
+                                            lambda event: progress({**event, "bus": bus}), request.store, cancel))
+            return results
 
         return _per_node(run_per_drive([connection.drive(node) for node in nodes], restore_one))
 
@@ -87,6 +93,15 @@ def _per_node(results: dict[int, object]) -> dict:
 @router.get("/jobs", response_model=list[JobModel], summary="Recent jobs")
 def list_jobs(jobs: JobRegistry = Depends(get_jobs)) -> list[dict]:
     return [job.as_dict() for job in jobs.list()]
+
+
+@router.post("/jobs/{job_id}/cancel", response_model=JobModel,
+             summary="Cancel a running job: it stops at the next object or file boundary and ends 'cancelled'")
+def cancel_job(job_id: str, jobs: JobRegistry = Depends(get_jobs)) -> dict:
+    job = jobs.cancel(job_id)
+    if job is None:
+        raise HTTPException(404, f"no job {job_id!r}")
+    return job.as_dict()
 
 
 @router.get("/jobs/{job_id}", response_model=JobModel, summary="A job's state and result")
@@ -109,11 +124,15 @@ def download_file(bus: str, node: int, name: str, manager: ConnectionManager = D
 
 
 @router.put("/buses/{bus}/nodes/{node}/files/{name}",
-            summary="Upload a file and restore it to the drive (validated first; 422 names the line)")
+            summary="Upload a file and restore it to the drive (validated first; 422 names the line); with "
+                    "job=true as a cancellable job (202, progress on /api/ws/events)")
 def upload_file(bus: str, node: int, name: str, text: str = Body(..., media_type="text/plain"), store: bool = True,
-                manager: ConnectionManager = Depends(get_connections)) -> dict:
+                job: bool = False, manager: ConnectionManager = Depends(get_connections),
+                jobs: JobRegistry = Depends(get_jobs)) -> dict:
     kind = _kinds([name])[0]
     drive = manager.get(bus).drive(node)
+    if job:
+        return JSONResponse(_restore_upload_job(jobs, bus, drive, kind, text, store), status.HTTP_202_ACCEPTED)
     with tempfile.TemporaryDirectory() as folder:
         path = Path(folder) / kind.value
         path.write_text(text, encoding="latin-1")
@@ -121,3 +140,19 @@ def upload_file(bus: str, node: int, name: str, text: str = Body(..., media_type
     shown = result.as_dict()
     shown["file"] = name
     return shown
+
+
+def _restore_upload_job(jobs: JobRegistry, bus: str, drive, kind: FileKind, text: str, store: bool) -> dict:
+    """The uploaded file restored by a job; its result is ``{node: [restore result]}`` like a restore job's."""
+    folder = Path(tempfile.mkdtemp(prefix="servostudio-upload-"))
+    path = folder / kind.value
+    path.write_text(text, encoding="latin-1")
+
+    def work(progress, cancel) -> dict:
+        try:
+            result = restore_file(drive, path, kind, lambda event: progress({**event, "bus": bus}), store, cancel)
+        finally:
+            shutil.rmtree(folder, ignore_errors=True)
+        return {str(drive.node): [{**result.as_dict(), "file": kind.value}]}
+
+    return jobs.start("restore", work).as_dict()

@@ -1,7 +1,8 @@
 """WebSockets: ``/api/ws/events`` (bus, drive, progress and job events) and ``/api/ws/terminal`` (dialog terminal).
 
 Events are JSON objects with a ``type``: bus_state, bus_closed, scan, emcy, bootup, nmt_state, heartbeat_lost,
-heartbeat_back, progress, job, overflow.  ``/api/ws/events?types=emcy,progress`` filters.
+heartbeat_back, drive_state, progress, job, overflow.  While a client wants ``drive_state``, the known drives'
+status words are polled slowly (``services.bus.statewatch``).  ``/api/ws/events?types=emcy,progress`` filters.
 
 Terminal protocol (client → server): ``{"op": "watch", "items": [{"bus", "node", "object"}…], "period_ms": 200}``
 starts continuous monitoring (``{"op": "watch", "items": []}`` stops it), ``{"op": "read", "items": […]}`` reads once,

@@ -110,8 +110,9 @@ def start_commission(name: str, body: CommissionRequest, service: Service, conne
     service.store.open(name)  # an unknown project is refused now (404), not in the job
     live = LiveProjects(service, connections)
 
-    def work(progress) -> dict:
-        return live.commission(name, body.direction, body.axes, body.revision, progress=progress).as_dict()
+    def work(progress, cancel) -> dict:
+        return live.commission(name, body.direction, body.axes, body.revision, progress=progress,
+                               cancel=cancel).as_dict()
 
     return jobs.start(f"commission-{body.direction}", work).as_dict()
 

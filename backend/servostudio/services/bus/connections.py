@@ -21,6 +21,7 @@ from servostudio.drive.profiles import DeviceProfile, profile_for
 from servostudio.drive.sdo import SdoEngine
 from servostudio.od.library import EdsLibrary, builtin_library
 from servostudio.services.bus.events import EventHub
+from servostudio.services.bus.statewatch import StatuswordWatch
 from servostudio.transport.open import open_bus
 from servostudio.transport.spec import BusSpec, parse_bus_spec
 
@@ -64,20 +65,37 @@ class BusConnection:
     nodes: dict[int, NodeInfo] = field(default_factory=dict)
     simulation: object | None = None
     monitor: BusMonitor | None = None
+    _identifying: dict[int, threading.Lock] = field(default_factory=dict, repr=False)
+    _identifying_guard: threading.Lock = field(default_factory=threading.Lock, repr=False)
 
     def drive(self, node: int, device: str | None = None) -> Drive:
         """Drive access for a node: ``device`` if given, else the device a scan found (a node not scanned yet is
         identified now; one that does not answer gets a Drive without dictionary, which refuses typed access)."""
         if not 1 <= node <= 127:
             raise UnknownBusOrNode(f"node ID {node} outside 1..127")
-        info = self.nodes.get(node)
-        if info is None and device is None and self.link.connected:
-            from servostudio.services.scan import identify  # scan builds on this module
-
-            info = identify(self, node)
-        device = device or (info.device if info else None)
+        device = device or self._device_of(node)
         dictionary = self.library.load(device) if device else None
         return Drive(self.engine, node, dictionary, profile_for(device))
+
+    def _device_of(self, node: int) -> str | None:
+        """The node's device, identifying it first when unknown.
+
+        A node whose identity could not be read (no vendor ID: its answers were lost, e.g. under load) is
+        identified again rather than left without dictionary until the next scan.  Concurrent first requests
+        for one node identify it once: the others wait for that answer.
+        """
+        info = self.nodes.get(node)
+        if (info is not None and info.vendor_id is not None) or not self.link.connected:
+            return info.device if info else None
+        with self._identifying_guard:
+            lock = self._identifying.setdefault(node, threading.Lock())
+        with lock:
+            info = self.nodes.get(node)
+            if info is None or info.vendor_id is None:
+                from servostudio.services.scan import identify  # scan builds on this module
+
+                info = identify(self, node)
+        return info.device if info else None
 
     def profile_of(self, node: int) -> DeviceProfile | None:
         info = self.nodes.get(node)
@@ -119,6 +137,7 @@ class ConnectionManager:
         connection = BusConnection(bus_id, spec, link, SdoEngine(link, timeout), self.library, self.events,
                                    simulation=simulation)
         connection.monitor = BusMonitor(link, self.events.publish, connection.profile_of)
+        StatuswordWatch(connection, lambda: self.events.wants("drive_state"))
         link.on_state(lambda connected, reason: self.events.publish(
             {"type": "bus_state", "bus": bus_id, "connected": connected, "reason": reason}))
         with self._lock:

@@ -55,10 +55,21 @@ class EventHub:
             if subscription in self._subscriptions:
                 self._subscriptions.remove(subscription)
 
+    def wants(self, event_type: str) -> bool:
+        """Whether a subscriber would receive events of this type (lets a publisher skip costly work)."""
+        with self._lock:
+            return any(subscription.types is None or event_type in subscription.types
+                       for subscription in self._subscriptions)
+
     def add_listener(self, listener: Callable[[dict[str, object]], None]) -> None:
         """A plain callback run in the publisher's thread (CLI progress, tests)."""
         with self._lock:
             self._listeners.append(listener)
+
+    def remove_listener(self, listener: Callable[[dict[str, object]], None]) -> None:
+        with self._lock:
+            if listener in self._listeners:
+                self._listeners.remove(listener)
 
     def publish(self, event: dict[str, object]) -> None:
         event.setdefault("time", time.time())

@@ -1,7 +1,9 @@
 """Background jobs (backup, restore of many drives): run in a thread, publish progress and the result as events.
 
 A REST call that would take seconds starts a job and returns its id at once; the client follows it on
-``/api/ws/events`` (``progress`` and ``job`` events) or polls ``GET /api/jobs/{id}``.
+``/api/ws/events`` (``progress`` and ``job`` events) or polls ``GET /api/jobs/{id}``.  A client may cancel a
+running job: the work gets a ``Cancellation``, stops at the next object or file boundary and returns what it did
+so far; the job then ends ``cancelled`` with that result.
 """
 
 from __future__ import annotations
@@ -13,6 +15,7 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 
 from servostudio.services.bus.events import EventHub
+from servostudio.services.cancel import Cancellation
 
 Progress = Callable[[dict[str, object]], None]
 KEEP_JOBS = 100
@@ -22,11 +25,12 @@ KEEP_JOBS = 100
 class Job:
     id: str
     operation: str
-    state: str = "running"  # running | done | failed
+    state: str = "running"  # running | done | failed | cancelled
     result: object = None
     error: str = ""
     started: float = field(default_factory=time.time)
     finished: float | None = None
+    cancellation: Cancellation = field(default_factory=Cancellation, repr=False)
 
     def as_dict(self) -> dict[str, object]:
         return {"id": self.id, "operation": self.operation, "state": self.state, "result": self.result,
@@ -40,8 +44,9 @@ class JobRegistry:
         self._numbers = itertools.count(1)
         self._lock = threading.Lock()
 
-    def start(self, operation: str, work: Callable[[Progress], object]) -> Job:
-        """Run ``work(progress)`` in a thread; its return value (JSON-ready) becomes the job's result."""
+    def start(self, operation: str, work: Callable[[Progress, Cancellation], object]) -> Job:
+        """Run ``work(progress, cancellation)`` in a thread; its return value (JSON-ready) becomes the job's
+        result."""
         job = Job(id=f"job{next(self._numbers)}", operation=operation)
         with self._lock:
             self._jobs[job.id] = job
@@ -53,15 +58,22 @@ class JobRegistry:
 
         def run() -> None:
             try:
-                job.result = work(progress)
-                job.state = "done"
+                job.result = work(progress, job.cancellation)
+                job.state = "cancelled" if job.cancellation.requested else "done"
             except Exception as error:  # the job reports any failure to its client
                 job.error = str(error)
-                job.state = "failed"
+                job.state = "cancelled" if job.cancellation.requested else "failed"
             job.finished = time.time()
             self.events.publish({"type": "job", **job.as_dict()})
 
         threading.Thread(target=run, name=job.id, daemon=True).start()
+        return job
+
+    def cancel(self, job_id: str) -> Job | None:
+        """Ask a running job to stop (no effect on a finished one); None for an unknown id."""
+        job = self._jobs.get(job_id)
+        if job is not None and job.state == "running":
+            job.cancellation.cancel()
         return job
 
     def get(self, job_id: str) -> Job | None:

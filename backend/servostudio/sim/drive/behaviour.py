@@ -53,7 +53,7 @@ from servostudio.sim.drive.statemachine import (
 )
 from servostudio.sim.drive.runner import ProcedureRunner
 from servostudio.sim.drive.units import RPM, UnitScaling
-from servostudio.sim.objects import ObjectStore, zero_value
+from servostudio.sim.objects import ObjectStore
 from servostudio.sim.plant import FEEDBACK_ENCODER, PHASE_240, Plant
 
 REMOTE = 1 << 9
@@ -64,6 +64,15 @@ PARAMETER_REFRESH_PERIODS = 128
 SUPERVISION_PERIODS = 4
 SLOW_PUBLISH_PERIODS = 32
 STANDSTILL_SPEED = 0.5  # rad/s: a stop has ended below this speed
+DEFAULT_DRIVE_RATED_CURRENT = 5.0
+"""A, the smallest drive rating the simulated drives have (a larger motor gets a drive rated for its stall current)."""
+UNDERVOLTAGE_DEFAULTS = {400: 210, 230: 100, 48: 30, 34: 20, 17: 17}
+"""XtrapulsPac operating voltage (Vac) → undervoltage threshold default 0x6510,5 (V), manual §0x6510."""
+
+
+def supply_class(dc_bus_voltage: float) -> int:
+    """The operating voltage class (Vac) whose rectified peak is nearest to the DC bus voltage."""
+    return min(UNDERVOLTAGE_DEFAULTS, key=lambda vac: abs(vac * math.sqrt(2.0) - dc_bus_voltage))
 
 
 _STOPPING = Phase.STOPPING
@@ -136,6 +145,7 @@ class DriveBehaviour:
         self._current_filter_alpha = 1.0
         self._velocity_filter = 0.0
         self._velocity_filter_alpha = 1.0
+        self.set_hardware_data()
         if commissioned:
             self.apply_commissioning()
         self._register_hooks()
@@ -248,6 +258,30 @@ class DriveBehaviour:
 
     # -- commissioning ------------------------------------------------------------------------------------------
 
+    def set_hardware_data(self) -> None:
+        """Factory values of the drive's hardware where its dictionary gives no default: the node ID switches,
+        current ratings sized for the plant's motor, the sensor's increments per revolution, and the supply voltage
+        class of the plant's DC bus with the manual's undervoltage default for it."""
+        rated = max(self.plant.stall_current, DEFAULT_DRIVE_RATED_CURRENT)
+        voltage = supply_class(self.plant.dc_bus_voltage)
+        values = {
+            "device_id": self.store.node_id,
+            "drive_max_current": round(max(self.plant.peak_current, rated) * 1000),
+            "drive_rated_current": round(rated * 1000),
+            "drive_voltage": 400 if voltage == 400 else 230,
+            "operating_voltage": voltage,
+            "undervoltage_threshold": UNDERVOLTAGE_DEFAULTS[voltage],
+            "encoder_increments": self.physics.counts_per_turn,
+        }
+        for name, value in values.items():
+            address = self._addresses.get(name)
+            if address is None:
+                continue
+            variable = self.store.od[address]
+            if variable.default_for(self.store.node_id) is None:
+                self.store.set_factory(address[0], address[1], self._fit(variable, value))
+        self.snapshot()
+
     def apply_commissioning(self) -> None:
         """Write the plant's true motor data, phasing and gains over the dictionary defaults."""
         values = commissioned_values(self.plant, float(self.p.get("drive_max_current", 0)),
@@ -258,10 +292,7 @@ class DriveBehaviour:
             if address is None:
                 continue
             variable = self.store.od[address]
-            factory = variable.default_for(self.store.node_id)
-            if factory is None:
-                factory = zero_value(variable.data_type)
-            if self.store.get(*address) == factory:
+            if self.store.get(*address) == self.store.factory_value(variable):
                 self.store.set(address[0], address[1], self._fit(variable, value))
 
     @staticmethod

@@ -125,6 +125,9 @@ _COMMON_402: dict[str, Address] = {
 XTRAPULSPAC = DeviceProfile(
     key="xtrapulspac",
     objects=_COMMON_402 | {
+        "device_id": (0x200A, 1),
+        "drive_voltage": (0x6510, 3),
+        "operating_voltage": (0x6510, 4),
         "error_word_1": (0x3022, 1),
         "error_word_2": (0x3022, 2),
         "infranor_error_code": (0x3023, 4),

@@ -10,6 +10,9 @@ restored as the project holds it (an empty file clears the drive's sequences).
 
 Upload reads the drives' files with ``services.backup.backup_drive`` into a scratch directory, checks them against
 the axis's dictionary, and then replaces the axis files of every uploaded axis in one project change.
+
+A cancellation stops a download at the next object (the axis's file result says what was written) and an upload
+at the next file; a cancelled upload changes nothing in the project.
 """
 
 from __future__ import annotations
@@ -25,6 +28,7 @@ from servostudio.drive.access import Drive
 from servostudio.formats.objectfile import ObjectEntry, format_object_file, write_object_file
 from servostudio.services.backup import FileKind, backup_drive, drive_file_kinds, restore_file
 from servostudio.services.bus import ConnectionManager
+from servostudio.services.cancel import Cancellation
 from servostudio.services.projects import layout
 from servostudio.services.projects.axisvalues import AxisValues
 from servostudio.services.projects.errors import ConflictError, ProjectError, ValidationError
@@ -68,7 +72,8 @@ class CommissionReport:
 
 def commission(service: ProjectService, manager: ConnectionManager, project: str, direction: str = "check",
                axes: Iterable[str] | None = None, buses: Mapping[str, str] | None = None,
-               expected_revision: str | None = None, progress: Progress | None = None) -> CommissionReport:
+               expected_revision: str | None = None, progress: Progress | None = None,
+               cancel: Cancellation | None = None) -> CommissionReport:
     """Check the chosen axes (all by default), then download or upload the usable ones."""
     if direction not in DIRECTIONS:
         raise ValidationError(f"direction must be one of {', '.join(DIRECTIONS)}, not {direction!r}")
@@ -83,10 +88,14 @@ def commission(service: ProjectService, manager: ConnectionManager, project: str
         if direction == "download":
             copies = _copy_axis_files(service, project, [report.link for report in usable], Path(scratch))
             _parallel(usable, lambda report: _download(report, copies[report.link.axis.name], Path(scratch),
-                                                       progress, project))
+                                                       progress, project, cancel))
         elif direction == "upload":
             _parallel(usable, lambda report: _backup(report, Path(scratch) / report.link.axis.name, progress,
-                                                     project))
+                                                     project, cancel))
+            if cancel is not None and cancel.requested:
+                for report in usable:
+                    report.error = report.error or "upload cancelled; the project was not changed"
+                return CommissionReport(project, direction, reports, service.store.open(project).revision)
             revision = _install(service, project, [r for r in usable if not r.error], Path(scratch),
                                 expected_revision or snapshot.revision)
             return CommissionReport(project, direction, reports, revision)
@@ -115,21 +124,23 @@ def _copy_axis_files(service: ProjectService, project: str, links: list[AxisLink
 
 
 def _download(report: AxisReport, copy: _AxisCopy, scratch: Path, progress: Progress | None,
-              project: str) -> None:
+              project: str, cancel: Cancellation | None = None) -> None:
     drive = report.link.drive()
     relay = _relay(progress, project, report.link)
     outgoing = scratch / "download" / report.link.axis.name
     outgoing.mkdir(parents=True)
     for kind in drive_file_kinds(drive):
+        if cancel is not None and cancel.requested:
+            return  # files not started are left out of the report
         if kind is FileKind.SEQUENCE:
             source = copy.directory / layout.SEQUENCE
             if not source.is_file():
                 continue
-            result = restore_file(drive, source, kind, relay).as_dict()
+            result = restore_file(drive, source, kind, relay, cancel=cancel).as_dict()
         else:
             path = outgoing / kind.value
             left_out = _complete_file(copy.values, kind, path)
-            result = restore_file(drive, path, kind, relay).as_dict()
+            result = restore_file(drive, path, kind, relay, cancel=cancel).as_dict()
             result["not_in_project"] = left_out
         result["file"] = kind.value
         report.files.append(result)
@@ -163,9 +174,10 @@ def _complete_file(values: AxisValues, kind: FileKind, path: Path) -> list[str]:
 
 # ---- upload -----------------------------------------------------------------------------------------------------
 
-def _backup(report: AxisReport, directory: Path, progress: Progress | None, project: str) -> None:
+def _backup(report: AxisReport, directory: Path, progress: Progress | None, project: str,
+            cancel: Cancellation | None = None) -> None:
     drive: Drive = report.link.drive()
-    results = backup_drive(drive, directory, drive_file_kinds(drive), _relay(progress, project, report.link))
+    results = backup_drive(drive, directory, drive_file_kinds(drive), _relay(progress, project, report.link), cancel)
     report.files = [{**result.as_dict(), "file": result.kind, "ok": True} for result in results]
 
 

@@ -5,6 +5,7 @@ from __future__ import annotations
 from collections.abc import Iterable, Mapping, Sequence
 
 from servostudio.services.bus import ConnectionManager
+from servostudio.services.cancel import Cancellation
 from servostudio.services.projects.live.commission import CommissionReport, Progress, commission
 from servostudio.services.projects.live.links import AxisLink, link_axis
 from servostudio.services.projects.live.motorlive import select_motor_live
@@ -46,9 +47,9 @@ class LiveProjects:
 
     def commission(self, project: str, direction: str = "check", axes: Iterable[str] | None = None,
                    expected_revision: str | None = None, buses: Mapping[str, str] | None = None,
-                   progress: Progress | None = None) -> CommissionReport:
+                   progress: Progress | None = None, cancel: Cancellation | None = None) -> CommissionReport:
         return commission(self.projects, self.connections, project, direction, axes, buses, expected_revision,
-                          progress)
+                          progress, cancel)
 
     def scan(self, project: str, bus: str, bus_name: str | None = None, expected_revision: str | None = None,
              create: bool = False) -> ScanReport:
