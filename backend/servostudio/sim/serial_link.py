@@ -15,7 +15,6 @@ Two endpoints carry the byte stream: a raw TCP server (pyserial `socket://HOST:P
 
 from __future__ import annotations
 
-import logging
 import os
 import queue
 import select
@@ -26,9 +25,9 @@ import tty
 from servostudio.sim.frame import Frame
 from servostudio.sim.network import SimulatedNetwork
 from servostudio.sim.node import REDIRECTED_REQUEST_BASE, REDIRECTED_RESPONSE_BASE, SimulatedNode
+from servostudio.sim.tcp import TcpListener
 from servostudio.transport.rs232_framing import DRIVE_HEADER, HOST_HEADER, FrameDecoder, encode_frame
 
-log = logging.getLogger(__name__)
 
 FORWARDED = range(REDIRECTED_REQUEST_BASE + 1, REDIRECTED_REQUEST_BASE + 64)  # 0x641–0x67F
 RELAYED = range(REDIRECTED_RESPONSE_BASE + 1, REDIRECTED_RESPONSE_BASE + 64)  # 0x5C1–0x5FF
@@ -112,52 +111,24 @@ class SerialGateway:
             self._to_host(frame)
 
 
-class SerialTcpServer:
+class SerialTcpServer(TcpListener):
     """The line as a raw TCP byte stream (pyserial `socket://HOST:PORT`); every connection sees the drive's output."""
 
+    name = "serial-tcp"
+
     def __init__(self, gateway: SerialGateway, host: str = "127.0.0.1", port: int = 0) -> None:
+        super().__init__(host, port)
         self.gateway = gateway
-        self._listener = socket.create_server((host, port))
-        self._listener.settimeout(0.2)
-        self._stop = threading.Event()
         self._connections: list[socket.socket] = []
-        self._thread = threading.Thread(target=self._accept_loop, name="serial-tcp", daemon=True)
 
-    @property
-    def address(self) -> tuple[str, int]:
-        host, port = self._listener.getsockname()[:2]
-        return host, port
+    def _connected(self, connection: socket.socket) -> None:
+        connection.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
+        self._connections.append(connection)
+        threading.Thread(target=self._serve, args=(connection,), name="serial-tcp-rx", daemon=True).start()
 
-    def start(self) -> "SerialTcpServer":
-        self._thread.start()
-        return self
-
-    def stop(self) -> None:
-        self._stop.set()
-        if self._thread.is_alive():
-            self._thread.join()
-        self._listener.close()
+    def _close_connections(self) -> None:
         for connection in list(self._connections):
             _close_socket(connection)
-
-    def __enter__(self) -> "SerialTcpServer":
-        return self.start()
-
-    def __exit__(self, *exc: object) -> None:
-        self.stop()
-
-    def _accept_loop(self) -> None:
-        while not self._stop.is_set():
-            try:
-                connection, peer = self._listener.accept()
-            except TimeoutError:
-                continue
-            except OSError:
-                return
-            log.info("serial link client %s connected", peer)
-            connection.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
-            self._connections.append(connection)
-            threading.Thread(target=self._serve, args=(connection,), name="serial-tcp-rx", daemon=True).start()
 
     def _serve(self, connection: socket.socket) -> None:
         writer = _Writer(connection.sendall, "serial-tcp-tx")

@@ -11,7 +11,6 @@ python-can reads each handshake answer with a single `recv`, so bus frames start
 
 from __future__ import annotations
 
-import logging
 import queue
 import socket
 import threading
@@ -19,8 +18,8 @@ import time
 
 from servostudio.sim.frame import Frame
 from servostudio.sim.network import SimulatedNetwork
+from servostudio.sim.tcp import TcpListener
 
-log = logging.getLogger(__name__)
 
 DEFAULT_PORT = 29536
 DEFAULT_CHANNEL = "can0"
@@ -45,52 +44,26 @@ def parse_send(arguments: list[str]) -> Frame:
     return Frame(can_id, data, extended=len(arguments[0]) == 8)
 
 
-class SocketcandServer:
+class SocketcandServer(TcpListener):
+    """The simulated bus as a socketcand server: each client opens the channel and exchanges frames in raw mode."""
+
+    name = "socketcand"
+
     def __init__(self, network: SimulatedNetwork, host: str = "127.0.0.1", port: int = DEFAULT_PORT,
                  channel: str = DEFAULT_CHANNEL) -> None:
+        super().__init__(host, port)
         self.network = network
         self.channel = channel
-        self._listener = socket.create_server((host, port), reuse_port=False)
-        self._listener.settimeout(0.2)
         self._sessions: list[_Session] = []
-        self._stop = threading.Event()
-        self._thread = threading.Thread(target=self._accept_loop, name="socketcand", daemon=True)
 
-    @property
-    def address(self) -> tuple[str, int]:
-        host, port = self._listener.getsockname()[:2]
-        return host, port
+    def _connected(self, connection: socket.socket) -> None:
+        session = _Session(self, connection)
+        self._sessions.append(session)
+        session.start()
 
-    def start(self) -> "SocketcandServer":
-        self._thread.start()
-        return self
-
-    def stop(self) -> None:
-        self._stop.set()
-        if self._thread.is_alive():
-            self._thread.join()
-        self._listener.close()
+    def _close_connections(self) -> None:
         for session in list(self._sessions):
             session.close()
-
-    def __enter__(self) -> "SocketcandServer":
-        return self.start()
-
-    def __exit__(self, *exc: object) -> None:
-        self.stop()
-
-    def _accept_loop(self) -> None:
-        while not self._stop.is_set():
-            try:
-                connection, peer = self._listener.accept()
-            except TimeoutError:
-                continue
-            except OSError:
-                return
-            log.info("socketcand client %s connected", peer)
-            session = _Session(self, connection)
-            self._sessions.append(session)
-            session.start()
 
     def _forget(self, session: "_Session") -> None:
         if session in self._sessions:
