@@ -72,3 +72,27 @@ def test_only_differences_then_write_changed_to_the_drive(page: Page, demo_serve
     expect(page.get_by_test_id("toast").last).to_contain_text("written to the drive")
     assert demo_server.api("GET", drive_path).json()["raw"] == wanted
     expect(row.locator('[data-col="drive"]')).to_have_text(str(wanted))
+
+
+def test_application_template_limits_the_editor_to_its_groups(page: Page, demo_server: DemoServer) -> None:
+    """Device Config (manual §1.8.1): after choosing a template the editor opens on that application's groups."""
+    demo_server.api("POST", "/api/projects", json={"name": "templated", "buses": [{"name": "sim", "interface": "sim"}]})
+    demo_server.api("POST", "/api/projects/templated/axes",
+                    json={"name": "A", "device": "xtrapulspac", "node_id": 1, "bus": "sim"})
+    chosen = demo_server.api("POST", "/api/projects/templated/axes/A/application", json={"template": "analog-speed"})
+    template = demo_server.api("GET", "/api/projects/templated/axes/A/application").json()
+    assert chosen.is_success and template["groups"]
+
+    page.goto(f"{demo_server.url}/projects/templated/axes/A/parameters")
+    group = page.get_by_test_id("param-group")
+    expect(group).to_have_value("@application")
+    count = page.get_by_test_id("param-count")
+    expect(count).not_to_have_text("882 of 882 entries")
+    shown = {text for text in page.locator(".prow.group").all_inner_texts()}
+    assert shown and all(any(name in text for name in template["groups"]) for text in shown), shown
+
+    group.select_option("")  # All groups (Expert)
+    expect(count).to_have_text("882 of 882 entries")
+    page.reload()
+    expect(page.get_by_test_id("param-group")).to_have_value("")
+    screenshot(page, "parameters-application-groups")

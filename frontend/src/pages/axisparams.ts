@@ -12,6 +12,7 @@ export async function parametersView(context: AxisContext): Promise<AxisViewPage
   const live = page.app.live;
   // Until the first state answer the axis is taken as online: reads are tried and a failure shows in the cells.
   const online = () => live.axis(axis.bus, axis.node_id)?.online ?? true;
+  const template = await projects.application(project.name, axis.name);
   const editor = new ParameterEditor(dictionary, {
     drive: {
       online,
@@ -43,6 +44,7 @@ export async function parametersView(context: AxisContext): Promise<AxisViewPage
       },
     },
     onQuery: (query) => page.app.replaceQuery(query),
+    application: template?.groups ? { title: template.title, groups: template.groups } : null,
   }, page.location);
   await editor.start();
   let wasOnline = online();

@@ -48,6 +48,8 @@ export interface ParameterSources {
   };
   /** Query (search, group) changed: keep it in the URL. */
   onQuery(query: Record<string, string | undefined>): void;
+  /** The axis's application template (Device Config): the editor opens on only the groups it needs. */
+  application?: { title: string; groups: string[] } | null;
 }
 
 type Row =
@@ -58,6 +60,9 @@ type Row =
 const ROW_HEIGHT = 24;
 const READ_CHUNK = 40;
 const ALL_GROUPS = "";
+const APPLICATION_GROUPS = "@application";
+/** `?group=*`: every group, although the axis has an application template (Expert mode). */
+const EXPERT_QUERY = "*";
 const TARGETS_KEY = "servostudio.writeTargets";
 
 export class ParameterEditor {
@@ -83,6 +88,7 @@ export class ParameterEditor {
   private editor: HTMLElement | null = null;
   private editorKey = "";
   private readingForDiff = false;
+  private readonly applicationGroups: Set<string>;
 
   constructor(
     private readonly dictionary: Dictionary,
@@ -96,8 +102,11 @@ export class ParameterEditor {
       type: "search", placeholder: "Search index, name or description ( / )", style: { width: "300px" },
       "data-testid": "param-search", "aria-label": "Search parameters",
     });
+    const application = sources.application ?? null;
+    this.applicationGroups = new Set(application?.groups ?? []);
     this.groupSelect = h("select", { "data-testid": "param-group", "aria-label": "Group" },
-      h("option", { value: ALL_GROUPS }, "All groups"),
+      application ? h("option", { value: APPLICATION_GROUPS }, `${application.title}: its groups`) : null,
+      h("option", { value: ALL_GROUPS }, application ? "All groups (Expert)" : "All groups"),
       dictionary.groups.map((group) => h("option", { value: group }, group)));
     this.onlyDiff = h("input", { type: "checkbox", "data-testid": "param-only-diff" });
     this.countLabel = h("span", { class: "muted", "data-testid": "param-count" });
@@ -107,7 +116,7 @@ export class ParameterEditor {
     this.detail = h("div", { class: "panel detail", "data-testid": "param-detail" });
 
     this.searchInput.value = location.query.q ?? "";
-    this.groupSelect.value = dictionary.groups.includes(location.query.group ?? "") ? location.query.group! : ALL_GROUPS;
+    this.groupSelect.value = this.initialGroup(location.query.group, application !== null);
     let typingTimer = 0;
     this.searchInput.addEventListener("input", () => {
       clearTimeout(typingTimer);
@@ -175,7 +184,7 @@ export class ParameterEditor {
   /** Query-only URL change (back/forward between searches): update the filter in place. */
   update(location: Location): boolean {
     const q = location.query.q ?? "";
-    const group = location.query.group ?? ALL_GROUPS;
+    const group = this.initialGroup(location.query.group, this.applicationGroups.size > 0);
     if (q !== this.searchInput.value || group !== this.groupSelect.value) {
       this.searchInput.value = q;
       this.groupSelect.value = group;
@@ -186,18 +195,33 @@ export class ParameterEditor {
 
   // ---- filtering and rows -------------------------------------------------------------------------------------
 
+  /** The group from the URL when it names one; else the application's groups when a template is chosen. */
+  private initialGroup(fromUrl: string | undefined, hasApplication: boolean): string {
+    if (fromUrl === EXPERT_QUERY) return ALL_GROUPS;
+    if (fromUrl !== undefined && this.dictionary.groups.includes(fromUrl)) return fromUrl;
+    return hasApplication ? APPLICATION_GROUPS : ALL_GROUPS;
+  }
+
+  /** The URL form of a group choice: the default (the application's groups, or all without one) is left out. */
+  private groupQuery(group: string): string | undefined {
+    if (group === APPLICATION_GROUPS) return undefined;
+    if (group === ALL_GROUPS) return this.applicationGroups.size > 0 ? EXPERT_QUERY : undefined;
+    return group;
+  }
+
   private applyFilter(updateUrl: boolean): void {
     const text = this.searchInput.value;
     const group = this.groupSelect.value;
     let found = search(this.index, text);
-    if (group !== ALL_GROUPS) found = found.filter((entry) => entryGroup(entry) === group);
+    if (group === APPLICATION_GROUPS) found = found.filter((entry) => this.applicationGroups.has(entryGroup(entry)));
+    else if (group !== ALL_GROUPS) found = found.filter((entry) => entryGroup(entry) === group);
     if (this.onlyDiff.checked && !this.readingForDiff) found = found.filter((entry) => this.differs(entry));
     this.shown = found;
     const rows = text.trim() ? found.map((entry): Row => ({ kind: "entry", entry, sub: false })) : this.groupRows(found);
     this.list.setItems(rows);
     this.list.element.scrollTop = 0;
     this.countLabel.textContent = `${found.length} of ${this.entryList.length} entries`;
-    if (updateUrl) this.sources.onQuery({ q: text.trim() || undefined, group: group || undefined });
+    if (updateUrl) this.sources.onQuery({ q: text.trim() || undefined, group: this.groupQuery(group) });
     if (found.length > 0 && (!this.selected || !found.includes(this.selected))) this.select(found[0], false);
     this.renderBulk();
   }
