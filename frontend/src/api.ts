@@ -40,6 +40,18 @@ export async function errorOf(path: string, response: Response): Promise<ApiErro
   return new ApiError(response.status, `${path}: HTTP ${response.status}`);
 }
 
+let motionClient: string | null = null;
+
+/** The id the event socket announced. Every request names it, so the server can quick-stop the axes this page
+ * enabled when the page goes away (enabling is refused without it). */
+export function setMotionClient(id: string | null): void {
+  motionClient = id;
+}
+
+export function getMotionClient(): string | null {
+  return motionClient;
+}
+
 export async function request<T>(
   method: string,
   path: string,
@@ -48,6 +60,7 @@ export async function request<T>(
   signal?: AbortSignal,
 ): Promise<T> {
   const init: RequestInit = { method, headers: { Accept: "application/json" }, signal };
+  if (motionClient) (init.headers as Record<string, string>)["X-Servo-Client"] = motionClient;
   if (body instanceof FormData || body instanceof Blob) {
     init.body = body;
     if (body instanceof Blob && body.type) (init.headers as Record<string, string>)["Content-Type"] = body.type;

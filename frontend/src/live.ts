@@ -5,7 +5,7 @@
  * change, so axis states need no polling.
  */
 
-import type { AxisConfig } from "./api";
+import { setMotionClient, type AxisConfig } from "./api";
 import { busNames } from "./drives";
 import { STATE_LABELS, decodeState, type DriveState } from "./lib/cia402";
 
@@ -144,13 +144,16 @@ export class LiveHub {
     });
     socket.addEventListener("message", (message) => {
       try {
-        this.emit(JSON.parse(String(message.data)) as LiveEvent);
+        const event = JSON.parse(String(message.data)) as LiveEvent;
+        if (event.type === "hello") setMotionClient(String(event.client));
+        this.emit(event);
       } catch {
         // A frame that is not JSON is not an event.
       }
     });
     socket.addEventListener("close", () => {
       this.socketOpen = false;
+      setMotionClient(null);
       setTimeout(() => this.connect(), RECONNECT_MS);
     });
   }

@@ -4,6 +4,7 @@
  * terminal page both use it, so live values never need REST polling.
  */
 
+import { getMotionClient } from "./api";
 import type { ObjectValue } from "./drives";
 
 export interface WatchItem {
@@ -83,7 +84,7 @@ export class TerminalSocket {
   write(item: WatchItem, value: number | string, physical: boolean): Promise<ObjectValue> {
     return new Promise((resolve, reject) => {
       this.queue.push({ resolve: resolve as (value: unknown) => void, reject });
-      void this.send({ op: "write", ...item, value, physical });
+      void this.send({ op: "write", ...item, value, physical, client: getMotionClient() });
     });
   }
 

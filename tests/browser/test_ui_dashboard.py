@@ -1,6 +1,7 @@
 """Axis dashboard against the simulated drives: enabling needs explicit clicks and the state follows."""
 
 import re
+import time
 
 from playwright.sync_api import Page, expect
 
@@ -53,3 +54,27 @@ def test_live_values_and_enabling_the_axis_step_by_step(page: Page, demo_server:
     expect(state).to_have_text("Switch on disabled")
     assert drive_state(demo_server, node) == "SWITCH ON DISABLED"
 
+
+
+def test_closing_the_page_stops_the_axis_it_enabled(browser, demo_server: DemoServer) -> None:
+    """Motion needs a live client: when the page that enabled an axis goes away, the server quick-stops it."""
+    axis, node = demo_server.axes[2]
+    context = browser.new_context(viewport={"width": 1366, "height": 768})
+    page = context.new_page()
+    page.goto(f"{demo_server.url}/projects/demo/axes/{axis}")
+    state = page.get_by_test_id("dashboard-state")
+    expect(state).not_to_have_text("—")
+    if state.inner_text() != "Switch on disabled":
+        page.get_by_test_id("transition-disable_voltage").click()
+    expect(state).to_have_text("Switch on disabled")
+    for transition, shown in (("shutdown", "Ready to switch on"), ("switch_on", "Switched on"),
+                              ("enable_operation", "Operation enabled")):
+        page.get_by_test_id(f"transition-{transition}").click()
+        expect(state).to_have_text(shown)
+    assert drive_state(demo_server, node) == "OPERATION ENABLED"
+
+    context.close()  # the tab goes away: its event socket closes
+    deadline = time.monotonic() + 10
+    while drive_state(demo_server, node) == "OPERATION ENABLED" and time.monotonic() < deadline:
+        time.sleep(0.1)
+    assert drive_state(demo_server, node) in ("QUICK STOP ACTIVE", "SWITCH ON DISABLED")

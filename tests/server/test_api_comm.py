@@ -49,10 +49,13 @@ def test_read_write_and_refusals(client):
 
 
 def test_state_and_faults(client):
-    enabled = client.put("/api/buses/socketcand/nodes/2/state", json={"target": "operation-enabled"}).json()
-    assert enabled["state"] == "OPERATION ENABLED"
-    disabled = client.put("/api/buses/socketcand/nodes/2/state", json={"target": "switch-on-disabled"}).json()
-    assert disabled["state"] == "SWITCH ON DISABLED"
+    with client.websocket_connect("/api/ws/events?types=job") as socket:
+        motion_client = {"X-Servo-Client": socket.receive_json()["client"]}
+        enabled = client.put("/api/buses/socketcand/nodes/2/state", json={"target": "operation-enabled"},
+                             headers=motion_client).json()
+        assert enabled["state"] == "OPERATION ENABLED"
+        disabled = client.put("/api/buses/socketcand/nodes/2/state", json={"target": "switch-on-disabled"}).json()
+        assert disabled["state"] == "SWITCH ON DISABLED"
     faults = client.get("/api/buses/socketcand/nodes/2/faults").json()
     assert faults["fault"] is False and faults["faults"] == []
 
@@ -125,3 +128,33 @@ def test_real_http_through_uvicorn(socketcand, tmp_path):
     finally:
         server.should_exit = True
         thread.join(10)
+
+
+def test_enabling_needs_a_live_client_and_its_axes_stop_when_it_goes(client):
+    refused = client.put("/api/buses/socketcand/nodes/3/state", json={"target": "operation-enabled"})
+    assert refused.status_code == 409 and "live client" in refused.json()["detail"]
+    forged = client.put("/api/buses/socketcand/nodes/3/state", json={"target": "operation-enabled"},
+                        headers={"X-Servo-Client": "not-a-connected-client"})
+    assert forged.status_code == 409
+    raw_enable = client.put("/api/buses/socketcand/nodes/3/objects/controlword", json={"value": 0x0F})
+    assert raw_enable.status_code == 409 and "live client" in raw_enable.json()["detail"]
+    with client.websocket_connect("/api/ws/terminal") as terminal:
+        terminal.send_json({"op": "write", "bus": "socketcand", "node": 3, "object": "controlword", "value": 15})
+        answer = terminal.receive_json()
+        assert answer["type"] == "error" and "live client" in answer["detail"]
+    assert client.get("/api/buses/socketcand/nodes/3/state").json()["state"] == "SWITCH ON DISABLED"
+
+    with client.websocket_connect("/api/ws/events?types=job") as socket:
+        hello = socket.receive_json()
+        assert hello["type"] == "hello"
+        enabled = client.put("/api/buses/socketcand/nodes/3/state", json={"target": "operation-enabled"},
+                             headers={"X-Servo-Client": hello["client"]}).json()
+        assert enabled["state"] == "OPERATION ENABLED"
+    # The client went away: the server quick-stops the axis it enabled.
+    deadline = time.monotonic() + 10
+    state = "OPERATION ENABLED"
+    while state == "OPERATION ENABLED" and time.monotonic() < deadline:
+        time.sleep(0.05)
+        state = client.get("/api/buses/socketcand/nodes/3/state").json()["state"]
+    assert state in ("QUICK STOP ACTIVE", "SWITCH ON DISABLED"), state
+    client.put("/api/buses/socketcand/nodes/3/state", json={"target": "switch-on-disabled"})

@@ -145,3 +145,10 @@ def test_every_xtrapulspac_code_has_a_row():
     profile = profile_for("xtrapulspac")
     assert sorted(profile.errors) == list(range(1, 65))
     assert all(info.cia402_code for info in profile.errors.values())
+
+
+@pytest.mark.parametrize("start", [State.SWITCH_ON_DISABLED, State.READY_TO_SWITCH_ON, State.SWITCHED_ON, State.FAULT])
+def test_quick_stop_never_walks_a_stopped_axis_up(start):
+    """A drive whose quick-stop option code ends in SWITCH ON DISABLED is stopped, not re-enabled."""
+    assert next_command(start, State.QUICK_STOP_ACTIVE) is None
+    assert next_command(State.OPERATION_ENABLED, State.QUICK_STOP_ACTIVE) is Command.QUICK_STOP

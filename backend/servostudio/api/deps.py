@@ -16,6 +16,7 @@ from starlette.requests import HTTPConnection
 
 from servostudio.od import EdsLibrary
 from servostudio.services.bus import ConnectionManager, EventHub, JobRegistry
+from servostudio.services.motion import MotionGuard
 
 
 @dataclass(frozen=True)
@@ -41,6 +42,10 @@ def get_connections(connection: HTTPConnection) -> ConnectionManager:
     return connection.app.state.connections
 
 
+def get_motion(connection: HTTPConnection) -> MotionGuard:
+    return connection.app.state.motion
+
+
 def get_jobs(connection: HTTPConnection) -> JobRegistry:
     return connection.app.state.jobs
 
@@ -53,6 +58,7 @@ def install_communication(app: FastAPI, buses: list[str]) -> None:
     """Give the app its connection manager and jobs; open ``buses`` at startup, close everything at shutdown."""
     manager = ConnectionManager(getattr(app.state, "eds_library", None))
     app.state.connections = manager
+    app.state.motion = MotionGuard()
     app.state.jobs = JobRegistry(manager.events)
     previous = app.router.lifespan_context
 

@@ -83,16 +83,16 @@ def next_command(current: State, target: State) -> Command | None:
     """The command that moves one step from ``current`` towards ``target``; None when already there.
 
     Reachable targets: the four states of the normal ladder and QUICK STOP ACTIVE (from OPERATION ENABLED).
+    A quick stop is only ever a way down: from any state but OPERATION ENABLED the axis is already stopped and no
+    command is given (a drive whose quick-stop option code ends in SWITCH ON DISABLED must not be walked back up).
     A fault must be reset first (FAULT_RESET), which leads to SWITCH ON DISABLED.
     """
     if current is target:
         return None
+    if target is State.QUICK_STOP_ACTIVE:
+        return Command.QUICK_STOP if current is State.OPERATION_ENABLED else None
     if current is State.FAULT:
         return Command.FAULT_RESET
-    if target is State.QUICK_STOP_ACTIVE:
-        if current is State.OPERATION_ENABLED:
-            return Command.QUICK_STOP
-        return next_command(current, State.OPERATION_ENABLED)
     if current is State.QUICK_STOP_ACTIVE:
         return Command.DISABLE_VOLTAGE
     if target not in _ORDER or current not in _ORDER:

@@ -13,6 +13,7 @@ from dataclasses import dataclass
 from servostudio.drive.access import Drive, DriveAccessError
 from servostudio.drive.sdo import SdoError
 from servostudio.services.bus.connections import ConnectionManager
+from servostudio.services.motion import MotionGuard
 
 MAX_AXES = 4
 MAX_ITEMS = 32
@@ -68,10 +69,13 @@ def sample(manager: ConnectionManager, watch: Watch, timeout: float = 2.0) -> li
     return rows
 
 
-def write(manager: ConnectionManager, bus: str, node: int, key: str, value: object, physical: bool = False,
-          ) -> dict[str, object]:
-    """Write one object (checked against the dictionary first) and return what was written."""
+def write(manager: ConnectionManager, motion: MotionGuard, client: str | None, bus: str, node: int, key: str,
+          value: object, physical: bool = False) -> dict[str, object]:
+    """Write one object (checked against the dictionary first) and return what was written.
+
+    A control word that enables operation needs the caller's live motion client, as on the REST route."""
     drive = manager.get(bus).drive(node)
+    motion.check_controlword_write(client, (bus, node), drive, key, value)
     return drive.write(key, value, physical).as_dict()
 
 

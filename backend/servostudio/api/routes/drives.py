@@ -4,9 +4,9 @@ from __future__ import annotations
 
 from typing import Annotated
 
-from fastapi import APIRouter, Depends, Query
+from fastapi import APIRouter, Depends, Header, Query
 
-from servostudio.api.deps import current_user, get_connections
+from servostudio.api.deps import current_user, get_connections, get_motion
 from servostudio.api.routes.comm_models import (
     DriveState,
     FaultReportModel,
@@ -20,7 +20,12 @@ from servostudio.drive.access import Drive
 from servostudio.drive.cia402 import State
 from servostudio.drive.control import fault_report, read_state, reset_faults, set_state
 from servostudio.services.bus import ConnectionManager
+from servostudio.services.motion import MotionGuard
 from servostudio.services.terminal import read_objects
+
+#: The caller's live motion client (announced by /api/ws/events); required for anything that enables the drive.
+MotionClient = Annotated[str | None, Header(alias="X-Servo-Client",
+                                            description="id announced by /api/ws/events; required to enable")]
 
 router = APIRouter(prefix="/buses/{bus}/nodes/{node}", tags=["drives"], dependencies=[Depends(current_user)])
 #: A node not identified yet is identified on first use; ``?device=`` names its device instead (and overrides).
@@ -42,8 +47,11 @@ def read_object(bus: str, node: int, key: str, device: Device = None,
 @router.put("/objects/{key}", response_model=ObjectValueModel,
             summary="Write an object; access, type and range are checked before anything is sent")
 def write_object(bus: str, node: int, key: str, request: ObjectWrite, device: Device = None,
-                 manager: ConnectionManager = Depends(get_connections)) -> dict:
-    return _drive(bus, node, device, manager).write(key, request.value, request.physical).as_dict()
+                 manager: ConnectionManager = Depends(get_connections), motion: MotionGuard = Depends(get_motion),
+                 client: MotionClient = None) -> dict:
+    drive = _drive(bus, node, device, manager)
+    motion.check_controlword_write(client, (bus, node), drive, key, request.value)
+    return drive.write(key, request.value, request.physical).as_dict()
 
 
 @router.post("/read", response_model=list[ReadResult], summary="Read several objects of this node at once")
@@ -64,10 +72,17 @@ def get_state(bus: str, node: int, device: Device = None,
 
 @router.put("/state", response_model=DriveState, summary="Walk the CiA 402 state machine to a target state")
 def put_state(bus: str, node: int, request: StateRequest, device: Device = None,
-              manager: ConnectionManager = Depends(get_connections)) -> dict:
+              manager: ConnectionManager = Depends(get_connections), motion: MotionGuard = Depends(get_motion),
+              client: MotionClient = None) -> dict:
+    """Enabling (operation-enabled) needs a live motion client, which then answers for the axis."""
     connection = manager.get(bus)
     drive = connection.drive(node, device)
-    set_state(drive, State.parse(request.target))
+    target = State.parse(request.target)
+    if target is State.OPERATION_ENABLED:
+        motion.claim(client, (bus, node))
+    else:
+        motion.release((bus, node))
+    set_state(drive, target)
     state, statusword = read_state(drive)
     _report(connection, node, statusword)
     return {"node": node, "state": state.value if state else None, "statusword": statusword,

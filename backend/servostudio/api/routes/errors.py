@@ -12,6 +12,7 @@ from servostudio.drive.profiles import ProfileError
 from servostudio.drive.sdo import SdoAbortError, SdoError, SdoLinkError, SdoTimeoutError
 from servostudio.services.backup import BackupError, RestoreValidationError
 from servostudio.services.bus import UnknownBusOrNode
+from servostudio.services.motion import NoLiveClient
 from servostudio.services.terminal import TerminalError
 from servostudio.transport.spec import BusSpecError
 
@@ -26,6 +27,7 @@ STATUS = [
     (TerminalError, 422),
     (SdoAbortError, 409),
     (StateChangeError, 409),
+    (NoLiveClient, 409),
     (SdoTimeoutError, 504),
     (SdoLinkError, 503),
     (LinkDownError, 503),

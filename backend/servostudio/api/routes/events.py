@@ -6,7 +6,8 @@ status words are polled slowly (``services.bus.statewatch``).  ``/api/ws/events?
 
 Terminal protocol (client → server): ``{"op": "watch", "items": [{"bus", "node", "object"}…], "period_ms": 200}``
 starts continuous monitoring (``{"op": "watch", "items": []}`` stops it), ``{"op": "read", "items": […]}`` reads once,
-``{"op": "write", "bus", "node", "object", "value", "physical"}`` writes.  Server → client: ``{"type": "values",
+``{"op": "write", "bus", "node", "object", "value", "physical", "client"}`` writes (``client``: the motion client
+id from /api/ws/events, needed for a control word that enables operation).  Server → client: ``{"type": "values",
 "rows": [...]}``, ``{"type": "written", "value": {...}}``, ``{"type": "error", "detail": "..."}``.
 """
 
@@ -17,8 +18,9 @@ import contextlib
 
 from fastapi import APIRouter, Depends, WebSocket, WebSocketDisconnect
 
-from servostudio.api.deps import User, current_user, get_connections, get_events
+from servostudio.api.deps import User, current_user, get_connections, get_events, get_motion
 from servostudio.services.bus import ConnectionManager, EventHub
+from servostudio.services.motion import MotionGuard
 from servostudio.services.terminal import TerminalError, Watch, WatchItem, sample, write
 
 router = APIRouter(tags=["events"])
@@ -26,11 +28,17 @@ router = APIRouter(tags=["events"])
 
 @router.websocket("/ws/events")
 async def events_socket(socket: WebSocket, types: str | None = None, user: User = Depends(current_user),
-                        hub: EventHub = Depends(get_events)) -> None:
+                        hub: EventHub = Depends(get_events), motion: MotionGuard = Depends(get_motion),
+                        manager: ConnectionManager = Depends(get_connections)) -> None:
+    """Events as they happen. The socket is also the caller's motion client: its first message,
+    ``{"type": "hello", "client": ID}``, gives the id that enabling a drive must name (X-Servo-Client), and the
+    axes it enabled get a quick stop when the socket closes."""
     await socket.accept()
+    client = motion.connect()
     subscription = hub.subscribe(set(types.split(",")) if types else None)
     receiver = asyncio.create_task(_drain(socket))
     try:
+        await socket.send_json({"type": "hello", "client": client})
         while not receiver.done():
             getter = asyncio.create_task(subscription.get())
             done, _ = await asyncio.wait({getter, receiver}, return_when=asyncio.FIRST_COMPLETED)
@@ -43,6 +51,7 @@ async def events_socket(socket: WebSocket, types: str | None = None, user: User 
     finally:
         subscription.close()
         receiver.cancel()
+        await asyncio.to_thread(motion.disconnect, client, manager)
 
 
 async def _drain(socket: WebSocket) -> None:
@@ -54,7 +63,8 @@ async def _drain(socket: WebSocket) -> None:
 
 @router.websocket("/ws/terminal")
 async def terminal_socket(socket: WebSocket, user: User = Depends(current_user),
-                          manager: ConnectionManager = Depends(get_connections)) -> None:
+                          manager: ConnectionManager = Depends(get_connections),
+                          motion: MotionGuard = Depends(get_motion)) -> None:
     await socket.accept()
     monitor: asyncio.Task | None = None
     try:
@@ -63,9 +73,9 @@ async def terminal_socket(socket: WebSocket, user: User = Depends(current_user),
             try:
                 operation = message.get("op")
                 if operation == "write":
-                    value = await asyncio.to_thread(write, manager, message["bus"], int(message["node"]),
-                                                    str(message["object"]), message["value"],
-                                                    bool(message.get("physical", False)))
+                    value = await asyncio.to_thread(write, manager, motion, message.get("client"),
+                                                    message["bus"], int(message["node"]), str(message["object"]),
+                                                    message["value"], bool(message.get("physical", False)))
                     await socket.send_json({"type": "written", "value": value})
                 elif operation in ("read", "watch"):
                     watch = _watch(message)
