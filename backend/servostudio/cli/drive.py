@@ -7,6 +7,9 @@ Each command opens the bus, does its work, prints JSON on stdout and exits with 
 from __future__ import annotations
 
 import argparse
+import signal
+import sys
+import threading
 from collections.abc import Callable
 from pathlib import Path
 
@@ -74,7 +77,8 @@ def register(commands: argparse._SubParsersAction) -> None:
     nmt.add_argument("--node", type=int, default=0, help="node ID (default 0: all nodes)")
     fault = add("fault", "show active faults with the manual's remedy; --reset resets them", _fault)
     fault.add_argument("--reset", action="store_true")
-    state = add("state", "show the CiA 402 state, or walk to TARGET", _state)
+    state = add("state", "show the CiA 402 state, or walk to TARGET (operation-enabled holds the axis enabled "
+                         "until the command is interrupted, then quick-stops it)", _state)
     state.add_argument("target", nargs="?", help="switch-on-disabled, ready-to-switch-on, switched-on, "
                        "operation-enabled, quick-stop-active")
 
@@ -205,7 +209,26 @@ def _fault(args: argparse.Namespace, connection: BusConnection) -> object:
 
 def _state(args: argparse.Namespace, connection: BusConnection) -> object:
     drive = _drive(args, connection)
-    if args.target:
-        set_state(drive, State.parse(args.target))
+    target = State.parse(args.target) if args.target else None
+    if target is State.OPERATION_ENABLED:
+        _hold_enabled(drive)
+    elif target is not None:
+        set_state(drive, target)
     state, statusword = read_state(drive)
     return {"node": drive.node, "state": state.value if state else None, "statusword": statusword}
+
+
+def _hold_enabled(drive: Drive) -> None:
+    """Motion needs a live client: this command is it. The axis stays enabled while the command runs and gets a
+    quick stop when it ends (Ctrl-C, SIGTERM, SIGHUP)."""
+    stop = threading.Event()
+    previous = {sig: signal.signal(sig, lambda *_: stop.set()) for sig in (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)}
+    try:
+        set_state(drive, State.OPERATION_ENABLED)
+        print(f"node {drive.node}: operation enabled; holding until Ctrl-C or SIGTERM, then quick stop",
+              file=sys.stderr, flush=True)
+        stop.wait()
+    finally:
+        set_state(drive, State.QUICK_STOP_ACTIVE)
+        for sig, handler in previous.items():
+            signal.signal(sig, handler)
