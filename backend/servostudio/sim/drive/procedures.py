@@ -90,10 +90,9 @@ def circular_offset(samples: list[tuple[float, float]], pole_pairs: int, phase_s
     return (math.atan2(y, x) / TWO_PI) % 1.0, math.hypot(x, y) / count
 
 
-class AutoPhasing:
-    """'apha'. Drive it with `step(turns)`; read `angle`/`current` for the forced vector each period."""
+class _SweepProcedure:
+    """A phasing procedure driven by a forced current vector: align, then sweep; `result` or `failed_reason`."""
 
-    MAX_ELECTRICAL_TURNS = 26
     MIN_AGREEMENT = 0.95
 
     def __init__(self, dt: float, current: float) -> None:
@@ -101,9 +100,6 @@ class AutoPhasing:
         self.result: PhasingResult | None = None
         self.failed_reason = ""
         self._phase = "align"
-        self._start_turns = 0.0
-        self._electrical_turns = 0.0
-        self._direction = 1
         self._count = 0
 
     @property
@@ -114,20 +110,53 @@ class AutoPhasing:
     def current(self) -> float:
         return self.sweep.current
 
-    def step(self, turns: float) -> bool:
-        """Advance one period with the sensor position in mechanical turns; True when finished."""
+    def _tick(self, turns: float) -> bool:
+        """Advance the clock one period; True while the rotor is still aligning (it then starts "forward")."""
         sweep = self.sweep
         sweep.time += sweep.dt
         self._count += 1
-        if self._phase == "align":
-            if sweep.time >= sweep.ALIGN_TIME:
-                self._phase = "forward"
-                self._start_turns = turns
+        if self._phase != "align":
             return False
+        if sweep.time >= sweep.ALIGN_TIME:
+            self._phase = "forward"
+            self._sweep_started(turns)
+        return True
+
+    def _sweep_started(self, turns: float) -> None:
+        """Hook: the alignment is over at sensor position `turns`."""
+
+    def _ramp_and_sample(self, direction: int, turns: float) -> None:
+        self.sweep.ramp_rate(direction)
+        if self._count % 8 == 0:
+            self.sweep.sample(turns)
+
+    def _fail(self, reason: str) -> bool:
+        self.failed_reason = reason
+        self._phase = "done"
+        return True
+
+
+class AutoPhasing(_SweepProcedure):
+    """'apha'. Drive it with `step(turns)`; read `angle`/`current` for the forced vector each period."""
+
+    MAX_ELECTRICAL_TURNS = 26
+
+    def __init__(self, dt: float, current: float) -> None:
+        super().__init__(dt, current)
+        self._start_turns = 0.0
+        self._electrical_turns = 0.0
+        self._direction = 1
+
+    def _sweep_started(self, turns: float) -> None:
+        self._start_turns = turns
+
+    def step(self, turns: float) -> bool:
+        """Advance one period with the sensor position in mechanical turns; True when finished."""
+        if self._tick(turns):
+            return False
+        sweep = self.sweep
         if self._phase == "forward":
-            sweep.ramp_rate(+1)
-            if self._count % 8 == 0:
-                sweep.sample(turns)
+            self._ramp_and_sample(+1, turns)
             moved = turns - self._start_turns
             if abs(moved) >= 1.0:
                 self._electrical_turns = sweep.angle / TWO_PI
@@ -137,9 +166,7 @@ class AutoPhasing:
                 return self._fail("the shaft did not follow the rotating field (blocked or loaded?)")
             return False
         if self._phase == "backward":
-            sweep.ramp_rate(-1)
-            if self._count % 8 == 0:
-                sweep.sample(turns)
+            self._ramp_and_sample(-1, turns)
             if sweep.angle <= 0.0:
                 sweep.angle = 0.0
                 return self._finish()
@@ -157,46 +184,20 @@ class AutoPhasing:
         self._phase = "done"
         return True
 
-    def _fail(self, reason: str) -> bool:
-        self.failed_reason = reason
-        self._phase = "done"
-        return True
 
-
-class MotorPhasing:
+class MotorPhasing(_SweepProcedure):
     """'mcal': offset only, with known pole pairs and phase order (±1 electrical turn around the start)."""
 
-    MIN_AGREEMENT = 0.95
-
     def __init__(self, dt: float, current: float, pole_pairs: int, phase_sign: int) -> None:
-        self.sweep = ForcedVectorSweep(dt, current)
+        super().__init__(dt, current)
         self.pole_pairs = pole_pairs
         self.phase_sign = phase_sign
-        self.result: PhasingResult | None = None
-        self.failed_reason = ""
-        self._phase = "align"
-        self._count = 0
-
-    @property
-    def angle(self) -> float:
-        return self.sweep.angle
-
-    @property
-    def current(self) -> float:
-        return self.sweep.current
 
     def step(self, turns: float) -> bool:
-        sweep = self.sweep
-        sweep.time += sweep.dt
-        self._count += 1
-        if self._phase == "align":
-            if sweep.time >= sweep.ALIGN_TIME:
-                self._phase = "forward"
+        if self._tick(turns):
             return False
-        direction = 1 if self._phase == "forward" else -1
-        sweep.ramp_rate(direction)
-        if self._count % 8 == 0:
-            sweep.sample(turns)
+        sweep = self.sweep
+        self._ramp_and_sample(1 if self._phase == "forward" else -1, turns)
         if self._phase == "forward" and sweep.angle >= TWO_PI:
             self._phase = "backward"
         elif self._phase == "backward" and sweep.angle <= 0.0:
