@@ -40,6 +40,8 @@ log = logging.getLogger(__name__)
 
 SDO_REQUEST_BASE, SDO_RESPONSE_BASE = 0x600, 0x580
 REDIRECTED_REQUEST_BASE, REDIRECTED_RESPONSE_BASE = 0x640, 0x5C0
+SDO_TRAFFIC = (0x581, 0x67F)
+"""COB-IDs reserved to default SDO channels (CiA 301 restricted identifiers, never a PDO)."""
 COMMUNICATION_AREA = range(0x1000, 0x2000)
 SYNC_COB_ID, SYNC_PERIOD = 0x1005, 0x1006
 START_REMOTE_NODES = 0x2000
@@ -92,6 +94,7 @@ class SimulatedNode:
                              self.flash.confirmation_delay)
         self.redirected_sdo = SdoServer(self.store, clock, REDIRECTED_RESPONSE_BASE + node_id, sdo_response_time,
                                         self.flash.confirmation_delay) if node_id < 64 else None
+        self._sdo_request_ids = frozenset(self.sdo_request_ids())
         self._register_hooks()
         self._errors_before_boot: list[int] = []
         self.behaviour = behaviour_factory(self.store, self.events)
@@ -151,6 +154,8 @@ class SimulatedNode:
         can_id = frame.can_id
         if frame.extended:
             return
+        if SDO_TRAFFIC[0] <= can_id <= SDO_TRAFFIC[1] and can_id not in self._sdo_request_ids:
+            return  # another node's SDO channel (COB-IDs no PDO may use): most frames of a busy bus
         if can_id == NMT_COB_ID:
             if len(frame.data) >= 2 and frame.data[1] in (0, self.node_id):
                 self.nmt_command(frame.data[0])

@@ -12,6 +12,7 @@ python-can reads each handshake answer with a single `recv`, so bus frames start
 from __future__ import annotations
 
 import queue
+import select
 import socket
 import threading
 import time
@@ -25,6 +26,7 @@ DEFAULT_PORT = 29536
 DEFAULT_CHANNEL = "can0"
 SETTLE_TIME = 0.1
 OUTPUT_QUEUE_LIMIT = 100_000  # frames waiting for a client that does not read; beyond it they are dropped
+WRITE_POLL = 0.2  # how often a writer blocked by a client that does not read looks whether the session closed
 _MAX_COMMAND = 256
 
 
@@ -38,7 +40,7 @@ def parse_send(arguments: list[str]) -> Frame:
     if len(arguments) < 2:
         raise ValueError("send needs an identifier and a length")
     can_id, length = int(arguments[0], 16), int(arguments[1], 16)
-    data = bytes(int(byte, 16) for byte in arguments[2:])
+    data = bytes([int(byte, 16) for byte in arguments[2:]])
     if length != len(data):
         raise ValueError(f"length {length} but {len(data)} data bytes")
     return Frame(can_id, data, extended=len(arguments[0]) == 8)
@@ -71,7 +73,8 @@ class SocketcandServer(TcpListener):
 
 
 class _Session:
-    """One client connection: a reader thread parsing commands, a writer thread draining the output queue.
+    """One client connection: its commands are read on the simulation thread (`SimulatedNetwork.watch`), a writer
+    thread drains the output queue.
 
     A bus frame is sent straight from the simulation thread when nothing is waiting in the queue (a non-blocking
     send: one thread hand-over less per frame, which is most of an SDO round trip's host latency); when the socket
@@ -88,11 +91,12 @@ class _Session:
         self._opened = False
         self._attached = False
         self._closed = threading.Event()
+        self._buffer = ""
 
     def start(self) -> None:
         threading.Thread(target=self._write_loop, name="socketcand-tx", daemon=True).start()
-        threading.Thread(target=self._read_loop, name="socketcand-rx", daemon=True).start()
         self._put("< hi >")
+        self.server.network.watch(self.connection, self._on_readable)
 
     def close(self) -> None:
         if self._closed.is_set():
@@ -100,6 +104,7 @@ class _Session:
         self._closed.set()
         if self._attached:
             self.server.network.detach(self)
+        self.server.network.unwatch(self.connection)
         self._output.put(None)
         try:
             self.connection.shutdown(socket.SHUT_RDWR)
@@ -119,7 +124,7 @@ class _Session:
                 except BlockingIOError:
                     pass
                 except OSError:
-                    return  # the connection is gone; the reader thread closes the session
+                    return  # the connection is gone; the next read closes the session
                 if not data:
                     return
             if self._queued >= OUTPUT_QUEUE_LIMIT:
@@ -144,7 +149,7 @@ class _Session:
                 if isinstance(item, float):
                     time.sleep(item)
                 else:
-                    self.connection.sendall(item)
+                    self._send_all(item)
             except OSError:
                 self.close()
                 return
@@ -152,18 +157,27 @@ class _Session:
                 with self._queued_lock:
                     self._queued -= 1
 
-    def _read_loop(self) -> None:
-        buffer = ""
-        while not self._closed.is_set():
+    def _send_all(self, data: bytes) -> None:
+        """`sendall` for the non-blocking socket: wait until it can take more (OSError once it is closed)."""
+        while data:
             try:
-                chunk = self.connection.recv(4096)
-            except OSError:
-                break
-            if not chunk:
-                break
-            buffer += chunk.decode("ascii", errors="replace")
-            buffer = self._consume(buffer)
-        self.close()
+                data = data[self.connection.send(data):]
+            except BlockingIOError:
+                select.select([], [self.connection], [], WRITE_POLL)
+                if self._closed.is_set():
+                    raise OSError("session closed")
+
+    def _on_readable(self) -> None:
+        try:
+            chunk = self.connection.recv(65536)
+        except (BlockingIOError, InterruptedError):
+            return
+        except OSError:
+            chunk = b""
+        if not chunk:
+            self.close()
+            return
+        self._buffer = self._consume(self._buffer + chunk.decode("ascii", errors="replace"))
 
     def _consume(self, buffer: str) -> str:
         while True:

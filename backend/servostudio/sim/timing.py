@@ -5,19 +5,19 @@ worst-case bound, so two frames with the same length but different payloads may 
 fixed-form tail (CRC delimiter, ACK slot and delimiter, 7 EOF bits) and the 3-bit intermission are added unstuffed.
 
 Every SDO frame of a backup is a different frame, so the count runs once per frame: the section is built as one
-integer, the CRC is table-driven (a byte at a time), and only runs of 4 or more equal bits are looked at for stuff bits.
+integer, and both the CRC and the stuff bits are table-driven, a byte at a time. Stuffing is a small state machine
+(the last bit and how many equal bits end the stream, the stuff bit starting the next run), so a table gives, for
+each state and byte, the state after the byte and the stuff bits it needs.
 """
 
 from __future__ import annotations
 
-import re
 from functools import lru_cache
 
 from servostudio.sim.frame import Frame
 
 _CRC15_POLYNOMIAL = 0x4599
 _UNSTUFFED_TAIL_BITS = 1 + 2 + 7 + 3  # CRC delimiter, ACK slot + delimiter, end of frame, intermission
-_LONG_RUNS = re.compile("0{4,}|1{4,}")
 
 
 def _crc15_step(crc: int, bit: int) -> int:
@@ -65,18 +65,49 @@ def _section(frame: Frame) -> tuple[int, int]:
     return value << 15 | _crc15_of(value, length), length + 15
 
 
-def _stuff_bits_of(text: str) -> int:
-    """Stuff bits of a '0'/'1' string: one after every 5 equal bits. The stuff bit (the complement) starts the next
-    run, so a run right after a stuff bit needs only 4 bits for its own first stuff bit; shorter runs never matter."""
-    stuffed, stuffed_at_end_of = 0, -1
-    for run in _LONG_RUNS.finditer(text):
-        start, end = run.span()
-        first = 4 if start == stuffed_at_end_of else 5  # bits of this run until its first stuff bit
-        if end - start < first:
-            continue
-        extra, remainder = divmod(end - start - first, 5)
-        stuffed += 1 + extra
-        stuffed_at_end_of = end if remainder == 0 else -1
+_NO_BIT_YET = 8
+"""Stuffing state before the first bit; the others are `last bit * 4 + (equal bits ending the stream - 1)`."""
+
+
+def _stuff_step(state: int, bit: int) -> tuple[int, int]:
+    """(next state, stuff bits inserted) after one bit: a stuff bit follows 5 equal bits and starts the next run."""
+    if state != _NO_BIT_YET and state >> 2 == bit:
+        run = (state & 3) + 2
+        if run == 5:
+            return (bit ^ 1) << 2, 1
+        return bit << 2 | (run - 1), 0
+    return bit << 2, 0
+
+
+def _stuff_table() -> tuple[tuple[int, ...], ...]:
+    """For every state and byte: next state << 8 | stuff bits inserted (most significant bit first)."""
+    table = []
+    for state in range(_NO_BIT_YET + 1):
+        row = []
+        for byte in range(256):
+            current, stuffed = state, 0
+            for shift in range(7, -1, -1):
+                current, extra = _stuff_step(current, (byte >> shift) & 1)
+                stuffed += extra
+            row.append(current << 8 | stuffed)
+        table.append(tuple(row))
+    return tuple(table)
+
+
+_STUFF_TABLE = _stuff_table()
+
+
+def _stuff_bits_of(value: int, length: int) -> int:
+    """Stuff bits of the `length` bits of `value`, most significant bit first."""
+    state, stuffed = _NO_BIT_YET, 0
+    lead = length % 8
+    for shift in range(length - 1, length - 1 - lead, -1):
+        state, extra = _stuff_step(state, (value >> shift) & 1)
+        stuffed += extra
+    table = _STUFF_TABLE
+    for byte in (value & ((1 << (length - lead)) - 1)).to_bytes((length - lead) // 8, "big"):
+        entry = table[state][byte]
+        state, stuffed = entry >> 8, stuffed + (entry & 0xFF)
     return stuffed
 
 
@@ -93,14 +124,14 @@ def crc15(bits: list[int]) -> int:
 
 def count_stuff_bits(bits: list[int]) -> int:
     """Stuff bits inserted after every run of 5 equal bits (a stuff bit starts the next run)."""
-    return _stuff_bits_of("".join(map(str, bits)))
+    return _stuff_bits_of(int("".join(map(str, bits)) or "0", 2), len(bits))
 
 
 @lru_cache(maxsize=4096)
 def frame_bits(frame: Frame) -> int:
     """Bit times the frame occupies the bus, including stuff bits and the interframe space."""
     value, length = _section(frame)
-    return length + _stuff_bits_of(format(value, f"0{length}b")) + _UNSTUFFED_TAIL_BITS
+    return length + _stuff_bits_of(value, length) + _UNSTUFFED_TAIL_BITS
 
 
 def frame_duration(frame: Frame, bitrate: int | None) -> float:
