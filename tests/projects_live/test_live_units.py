@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from concurrent.futures import Future
+from types import SimpleNamespace
 
 import pytest
 from hypothesis import given, settings
@@ -20,46 +21,49 @@ DICTIONARY = builtin_library().load("xtrapulspac")
 
 
 class ScriptedDrive:
-    """Answers reads from a script: a value, an abort code, or a timeout; records the order of the requests."""
+    """Answers a batch of reads from a script: a value, an abort code, undecodable bytes or a timeout."""
 
     node = 1
 
     def __init__(self, script: dict[tuple[int, int], object]) -> None:
         self.script = script
         self.requested: list[tuple[int, int]] = []
-        self.futures: list[Future] = []
 
-    def submit_read(self, variable):
-        self.requested.append(variable.key)
-        future: Future = Future()
+    def submit_read_all(self, variables):
+        self.requested += [variable.key for variable in variables]
+        batch = SimpleNamespace(future=Future())
+        batch.future.set_result([self._outcome(variable) for variable in variables])
+        return batch
+
+    def _outcome(self, variable):
         answer = self.script[variable.key]
         if answer == "timeout":
-            future.set_exception(SdoTimeoutError(1, *variable.key, "no SDO response"))
-        elif isinstance(answer, tuple):
-            future.set_exception(SdoAbortError(1, *variable.key, answer[1]))
-        elif answer != "pending":
-            future.set_result(ObjectValue(1, variable, answer))
-        self.futures.append(future)
-        return future
+            return SdoTimeoutError(1, *variable.key, "no SDO response")
+        if answer == "undecodable":
+            return ValueError(f"{variable.label}: drive answered 01 02: not a value of its type")
+        if isinstance(answer, tuple):
+            return SdoAbortError(1, *variable.key, answer[1])
+        return ObjectValue(1, variable, answer)
 
 
 def variables(*keys):
     return [DICTIONARY[key] for key in keys]
 
 
-def test_all_reads_are_queued_before_the_first_answer_is_awaited():
-    drive = ScriptedDrive({(0x6083, 0): 5, (0x2004, 0): "axis\0\0", (0x6060, 0): ("abort", 0x06020000)})
-    source = DriveValues(drive, variables((0x6083, 0), (0x2004, 0), (0x6060, 0)))
-    assert drive.requested == [(0x6083, 0), (0x2004, 0), (0x6060, 0)]
-    assert (source.read(0x6083, 0), source.read(0x2004, 0), source.read(0x6060, 0)) == (5, "axis", None)
+def test_values_refusals_and_undecodable_answers_are_kept_apart():
+    drive = ScriptedDrive({(0x6083, 0): 5, (0x2004, 0): "axis\0\0", (0x6060, 0): ("abort", 0x06020000),
+                           (0x6084, 0): "undecodable"})
+    source = DriveValues(drive, variables((0x6083, 0), (0x2004, 0), (0x6060, 0), (0x6084, 0)))
+    assert drive.requested == [(0x6083, 0), (0x2004, 0), (0x6060, 0), (0x6084, 0)]
+    assert [source.read(*key) for key in drive.requested] == [5, "axis", None, None]
     assert "0x06020000" in source.refused[0x6060, 0]
+    assert "not a value" in source.refused[0x6084, 0]
 
 
-def test_a_drive_that_stops_answering_fails_the_read_and_cancels_the_rest():
-    drive = ScriptedDrive({(0x6083, 0): "timeout", (0x6084, 0): "pending"})
+def test_a_drive_that_stops_answering_fails_the_read():
+    drive = ScriptedDrive({(0x6083, 0): 5, (0x6084, 0): "timeout"})
     with pytest.raises(SdoTimeoutError):
         DriveValues(drive, variables((0x6083, 0), (0x6084, 0)))
-    assert drive.futures[1].cancelled()
 
 
 @settings(deadline=None)

@@ -126,3 +126,59 @@ def test_a_late_answer_about_another_object_is_ignored(virtual_channel):
         responder.join()
         link.close()
         drive_side.shutdown()
+
+
+def test_a_batch_of_reads_gives_every_outcome_in_order(engine):
+    """One future for many reads: values in request order, an abort where the object is missing, each reported."""
+    objects = [(0x1000, 0), (0x2FFF, 0), (0x2004, 0), (0x2002, 0)]
+    reported: list[int] = []
+    batch = engine.upload_all(5, objects, convert=lambda position, data: (position, data),
+                              on_each=lambda position, outcome: reported.append(position))
+    outcomes = batch.future.result(5)
+    assert outcomes[0] == (0, (0x00020192).to_bytes(4, "little"))
+    assert isinstance(outcomes[1], SdoAbortError) and outcomes[1].code == 0x06020000
+    assert outcomes[2] == (2, b"axis name longer than four")
+    assert outcomes[3] == (3, (-300).to_bytes(2, "little", signed=True))
+    assert sorted(reported) == [0, 1, 2, 3]
+
+
+def test_a_cancelled_batch_sends_no_more_requests(engine, slaves):
+    """Cancelling drops the reads not yet sent (they end as CancelledError); the node serves the next caller."""
+    from concurrent.futures import CancelledError
+
+    batch = engine.upload_all(1, [(0x2001, 0)] * 200)
+    batch.cancel()
+    outcomes = batch.future.result(5)
+    cancelled = [outcome for outcome in outcomes if isinstance(outcome, CancelledError)]
+    read = [outcome for outcome in outcomes if outcome == b"\x07"]
+    assert len(cancelled) + len(read) == 200 and len(cancelled) >= 190
+    assert engine.upload(1, 0x2001, 0).result(2) == b"\x07"
+
+
+def test_a_conversion_error_ends_only_its_own_read(engine):
+    def convert(position: int, data: bytes) -> int:
+        if position == 1:
+            raise ValueError("not a value of this type")
+        return data[0]
+
+    outcomes = engine.upload_all(1, [(0x2001, 0)] * 3, convert=convert).future.result(5)
+    assert outcomes[0] == 7 and outcomes[2] == 7
+    assert isinstance(outcomes[1], ValueError)
+
+
+def test_a_lost_link_ends_a_batch_with_link_errors(engine):
+    engine.link.close()
+    outcomes = engine.upload_all(1, [(0x2001, 0), (0x2002, 0)]).future.result(2)
+    assert all(isinstance(outcome, SdoLinkError) for outcome in outcomes)
+
+
+def test_an_empty_batch_is_done_at_once(engine):
+    assert engine.upload_all(1, []).future.result(0) == []
+
+
+def test_a_drive_that_stops_answering_ends_the_batch_at_the_first_silent_read(engine):
+    from concurrent.futures import CancelledError
+
+    outcomes = engine.upload_all(9, [(0x1000, 0)] * 50).future.result(10)
+    assert isinstance(outcomes[0], SdoTimeoutError)
+    assert all(isinstance(outcome, CancelledError) for outcome in outcomes[1:])

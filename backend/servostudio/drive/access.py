@@ -5,15 +5,17 @@ value fit its type, range and enumeration — is made before a frame is sent, an
 object.  The drive's own refusals arrive as SDO aborts translated by ``servostudio.drive.sdo``.
 
 Methods block the calling thread (they wait on the SDO engine); the ``submit_*`` variants return futures so
-many reads can be queued at once (backup) and awaited from asyncio with ``asyncio.wrap_future``.
+many reads can be queued at once and awaited from asyncio with ``asyncio.wrap_future``; ``submit_read_all`` reads a
+whole list (a backup) with one future.
 """
 
 from __future__ import annotations
 
+from collections.abc import Callable, Sequence
 from concurrent.futures import Future
 
 from servostudio.drive.profiles import DeviceProfile, profile_for
-from servostudio.drive.sdo import SdoEngine
+from servostudio.drive.sdo import SdoEngine, UploadBatch
 from servostudio.drive.values import ObjectValue, Raw, decode_raw, parse_input
 from servostudio.od.datatypes import DataType, encode
 from servostudio.od.model import Access, ObjectDictionary, Variable
@@ -68,6 +70,19 @@ class Drive:
             raise DriveAccessError(f"node {self.node}: {variable.label} is write-only")
         return self.engine.upload(self.node, variable.index, variable.subindex, timeout,
                                   convert=lambda data: ObjectValue(self.node, variable, decode_raw(variable, data)))
+
+    def submit_read_all(self, variables: Sequence[Variable],
+                        on_each: Callable[[int, ObjectValue | Exception], None] | None = None) -> UploadBatch:
+        """Queue reads of many objects at once; the batch's future gives, in order, an ObjectValue or the exception
+        that ended each read (see `UploadBatch`)."""
+        for variable in variables:
+            if not variable.access.readable:
+                raise DriveAccessError(f"node {self.node}: {variable.label} is write-only")
+        return self.engine.upload_all(
+            self.node, [(variable.index, variable.subindex) for variable in variables],
+            convert=lambda position, data: ObjectValue(self.node, variables[position],
+                                                       decode_raw(variables[position], data)),
+            on_each=on_each)
 
     def read(self, key: str | tuple[int, int] | Variable, timeout: float | None = None) -> ObjectValue:
         variable = key if isinstance(key, Variable) else self.variable(key)

@@ -5,6 +5,11 @@ the loss, keep serving other buses, and reopen the interface when it comes back.
 object: while the link is up a single reader thread receives frames and hands them to the subscribers of their
 COB-ID; when a receive or send fails the link goes down (listeners are told why), the bus is closed, and the
 thread tries to reopen it every ``reconnect_interval`` seconds.
+
+Frames that arrive together are dispatched as one batch. While the reader thread dispatches a batch, what its
+callbacks send is held back and leaves in one write at the end of the batch (the follow-up requests of several
+drives reach the bus together); then the ``after_dispatch`` callbacks run, so slower bookkeeping (completing
+futures, converting values) never delays a request.
 """
 
 from __future__ import annotations
@@ -42,6 +47,8 @@ class BusLink:
         self._subscribers: dict[int, list[FrameCallback]] = {}
         self._state_listeners: list[StateCallback] = []
         self._tickers: list[TickCallback] = []
+        self._after_dispatch: list[Callable[[], None]] = []
+        self._held: list[tuple[int, bytes]] | None = None  # sends of the reader thread during a batch
         self._stop = threading.Event()
         self._connected = threading.Event()
         self._first_attempt = threading.Event()
@@ -78,13 +85,15 @@ class BusLink:
         if bus is None or not self.connected:
             detail = f" ({self.last_error})" if self.last_error else ""
             raise LinkDownError(f"bus {self.name} is not connected{detail}")
-        fast_send = getattr(bus, "send_frame", None)  # our own buses skip building a python-can Message
+        if self._held is not None and threading.current_thread() is self._thread:
+            self._held.append((cob_id, data))  # leaves with the rest of the batch's answers
+            return
+        self._send_now(bus, [(cob_id, data)])
+
+    def _send_now(self, bus: can.BusABC, frames: list[tuple[int, bytes]]) -> None:
         try:
             with self._send_lock:
-                if fast_send is not None:
-                    fast_send(cob_id, data)
-                else:
-                    bus.send(can.Message(arbitration_id=cob_id, data=data, is_extended_id=False))
+                _write(bus, frames)
         except (can.CanError, OSError) as error:
             self._link_lost(str(error))
             raise LinkDownError(f"bus {self.name}: {error}") from error
@@ -101,6 +110,11 @@ class BusLink:
         """``callback(connected, reason)`` on every change of the link state."""
         self._state_listeners.append(callback)
 
+    def after_dispatch(self, callback: Callable[[], None]) -> None:
+        """``callback()`` on the reader thread after each batch of received frames was dispatched and the sends
+        it caused went out."""
+        self._after_dispatch.append(callback)
+
     def add_ticker(self, callback: TickCallback) -> None:
         """``callback(now)`` every ``TICK_INTERVAL`` or so (timeouts are checked there)."""
         self._tickers.append(callback)
@@ -112,17 +126,41 @@ class BusLink:
                 self._open()
                 continue
             try:
-                message = self._bus.recv(POLL_INTERVAL)
+                self._receive(self._bus)
             except (can.CanError, OSError, ValueError) as error:
                 self._link_lost(str(error))
                 self._stop.wait(min(self.reconnect_interval, 0.2))  # let the other side settle before reopening
                 continue
-            if message is not None and not message.is_error_frame and not message.is_remote_frame:
-                self._dispatch(message.arbitration_id, bytes(message.data), message.timestamp or time.time())
             now = time.monotonic()
             if now >= self._next_tick:
                 self._next_tick = now + TICK_INTERVAL
                 self._tick(now)
+
+    def _receive(self, bus: can.BusABC) -> None:
+        """Dispatch what arrives within ``POLL_INTERVAL``: every frame at once from our own buses
+        (``receive_frames``), else one python-can message."""
+        receive_frames = getattr(bus, "receive_frames", None)
+        if receive_frames is not None:
+            frames = [(cob_id, data, timestamp) for cob_id, data, timestamp, _ in receive_frames(POLL_INTERVAL)]
+        else:
+            message = bus.recv(POLL_INTERVAL)
+            frames = [] if message is None or message.is_error_frame or message.is_remote_frame else [
+                (message.arbitration_id, bytes(message.data), message.timestamp)]
+        if not frames:
+            return
+        self._held = []
+        try:
+            for cob_id, data, timestamp in frames:
+                self._dispatch(cob_id, data, timestamp or time.time())
+        finally:
+            held, self._held = self._held, None
+        if held:
+            try:
+                self._send_now(bus, held)
+            except LinkDownError:
+                return  # the listeners were told; the transfers waiting for these frames fail with the link
+        for callback in self._after_dispatch:
+            _safely_call(callback)
 
     def _open(self) -> None:
         try:
@@ -177,6 +215,27 @@ class BusLink:
                 listener(connected, reason)
             except Exception:
                 log.exception("bus %s: state listener failed", self.name)
+
+
+def _write(bus: can.BusABC, frames: list[tuple[int, bytes]]) -> None:
+    """Send standard data frames, all in one write where the bus can (``send_frames``), without building python-can
+    Messages where it offers ``send_frame``."""
+    if len(frames) > 1 and hasattr(bus, "send_frames"):
+        bus.send_frames(frames)
+        return
+    send_frame = getattr(bus, "send_frame", None)
+    for cob_id, data in frames:
+        if send_frame is not None:
+            send_frame(cob_id, data)
+        else:
+            bus.send(can.Message(arbitration_id=cob_id, data=data, is_extended_id=False))
+
+
+def _safely_call(callback: Callable[[], None]) -> None:
+    try:
+        callback()
+    except Exception:  # a faulty listener must not stop the bus
+        log.exception("after-dispatch callback failed")
 
 
 def _safely(callback: FrameCallback, cob_id: int, data: bytes, timestamp: float) -> None:

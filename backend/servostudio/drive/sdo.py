@@ -4,7 +4,8 @@ Every transfer is a small state machine driven by the frames the bus link delive
 thinks.  A caller gets a ``concurrent.futures.Future`` (``asyncio.wrap_future`` makes it awaitable), so a thread can
 wait on it and the event loop never does.  Each node has a FIFO: the next request to a node leaves the moment the
 previous response arrives, from the reader thread itself, so a backup of many drives keeps every drive busy and
-the bus full without one thread per drive.
+the bus full without one thread per drive.  Futures complete after the reader's batch of frames was handled and
+the follow-up requests left (``BusLink.after_dispatch``).
 
 A read whose request got no answer at all is sent once more before it times out (reads have no side effect, and
 one lost frame should not fail a 400-object backup); writes are never repeated.
@@ -19,9 +20,8 @@ import struct
 import threading
 import time
 from collections import deque
-from concurrent.futures import Future
-from collections.abc import Callable
-from dataclasses import dataclass, field
+from concurrent.futures import CancelledError, Future
+from collections.abc import Callable, Sequence
 
 from servostudio.drive.abort_codes import abort_text
 from servostudio.drive.link import BusLink, LinkDownError
@@ -62,25 +62,107 @@ class SdoLinkError(SdoError):
     """The bus went down before or during the transfer."""
 
 
-@dataclass
+class _FutureCompletion:
+    """The outcome of one transfer goes to a future (after ``convert`` of a successful result)."""
+
+    __slots__ = ("future", "convert")
+
+    def __init__(self, convert: Callable[[object], object] | None) -> None:
+        self.future: Future = Future()
+        self.convert = convert
+
+    def start(self, slot: int) -> bool:
+        return self.future.set_running_or_notify_cancel()  # from now on cancel() refuses: the outcome is known
+
+    def drive_silent(self) -> None:
+        """Nothing more to drop: the transfer itself ends with its timeout."""
+
+    def done(self, slot: int, outcome: object) -> None:
+        if self.future.done():
+            return
+        if not isinstance(outcome, Exception) and self.convert is not None:
+            try:
+                outcome = self.convert(outcome)
+            except Exception as error:  # ValueError: bytes that are no value; anything else reaches the caller too
+                outcome = error
+        if isinstance(outcome, Exception):
+            self.future.set_exception(outcome)
+        else:
+            self.future.set_result(outcome)
+
+
+class UploadBatch:
+    """Reads of many objects of one node with one future for all: ``future`` gives a list, in request order, of
+    each value (``convert(position, bytes)`` when given) or the exception that ended its read.
+
+    A backup reads hundreds of objects; one future per object would cost more client time than the frames.
+    ``on_each(position, outcome)`` runs as each read ends (on the bus reader thread: keep it short).
+    ``cancel()`` drops the reads not yet sent; their outcome is a ``CancelledError``. A read that times out drops
+    the rest the same way: a drive that stopped answering would otherwise cost a timeout per object.
+    """
+
+    def __init__(self, count: int, convert: Callable[[int, bytes], object] | None = None,
+                 on_each: Callable[[int, object], None] | None = None) -> None:
+        self.future: Future = Future()
+        self.future.set_running_or_notify_cancel()
+        self._outcomes: list[object] = [None] * count
+        self._left = count
+        self._convert = convert
+        self._on_each = on_each
+        self._cancelled = False
+        self._lock = threading.Lock()
+        if count == 0:
+            self.future.set_result([])
+
+    def cancel(self) -> None:
+        self._cancelled = True
+
+    def start(self, slot: int) -> bool:
+        return not self._cancelled
+
+    def drive_silent(self) -> None:
+        """A read timed out: the drive stopped answering, the reads still queued are dropped."""
+        self._cancelled = True
+
+    def done(self, slot: int, outcome: object) -> None:
+        if not isinstance(outcome, Exception) and self._convert is not None:
+            try:
+                outcome = self._convert(slot, outcome)
+            except Exception as error:  # ValueError: bytes that are no value; anything else reaches the caller too
+                outcome = error
+        with self._lock:
+            self._outcomes[slot] = outcome
+            self._left -= 1
+            last = self._left == 0
+        if self._on_each is not None:
+            self._on_each(slot, outcome)
+        if last:
+            self.future.set_result(self._outcomes)
+
+
 class _Transfer:
-    node: int
-    index: int
-    sub: int
-    timeout: float
-    download: bytes | None = None  # None: upload
-    future: Future = field(default_factory=Future)
-    deadline: float = 0.0
-    received: bytearray = field(default_factory=bytearray)
-    expected_size: int | None = None
-    toggle: int = 0
-    offset: int = 0
-    segmented: bool = False
-    abort_on_timeout: bool = True
-    retries: int = 0  # times the initiate request is sent again when it got no answer at all
-    answered: bool = False
-    repeated: bool = False
-    convert: Callable[[object], object] | None = None  # applied to the result before the future gets it
+    """One SDO transfer and where its state machine stands."""
+
+    __slots__ = ("node", "index", "sub", "timeout", "download", "completion", "slot", "deadline", "received",
+                 "expected_size", "toggle", "offset", "segmented", "abort_on_timeout", "retries", "answered",
+                 "repeated")
+
+    def __init__(self, node: int, index: int, sub: int, timeout: float, completion: _FutureCompletion | UploadBatch,
+                 slot: int = 0, download: bytes | None = None, abort_on_timeout: bool = True,
+                 retries: int = 0) -> None:
+        self.node, self.index, self.sub, self.timeout = node, index, sub, timeout
+        self.download = download  # None: upload
+        self.completion, self.slot = completion, slot
+        self.deadline = 0.0
+        self.received = bytearray()
+        self.expected_size: int | None = None
+        self.toggle = 0
+        self.offset = 0
+        self.segmented = False
+        self.abort_on_timeout = abort_on_timeout
+        self.retries = retries  # times the initiate request is sent again when it got no answer at all
+        self.answered = False
+        self.repeated = False
 
     def multiplexer(self) -> bytes:
         return struct.pack("<HB", self.index, self.sub)
@@ -109,6 +191,7 @@ class SdoEngine:
         self._finished: deque[tuple[_Transfer, object]] = deque()  # outcomes to hand over once the lock is free
         link.add_ticker(self._check_timeouts)
         link.on_state(self._link_state)
+        link.after_dispatch(self._hand_over)  # responses arrive on the reader thread: complete after the batch
 
     # -- public API --------------------------------------------------------------------------------------------
     def upload(self, node: int, index: int, sub: int, timeout: float | None = None, probe: bool = False,
@@ -118,39 +201,55 @@ class SdoEngine:
         A ``probe`` (scan) sends no abort when the node stays silent: there is nobody to tell, and on a slow serial
         link 127 useless abort frames would cost most of a second.
         """
-        return self._submit(_Transfer(node, index, sub, timeout or self.timeout, abort_on_timeout=not probe,
-                                      convert=convert, retries=0 if probe else UPLOAD_RETRIES))
+        completion = _FutureCompletion(convert)
+        self._submit([_Transfer(node, index, sub, timeout or self.timeout, completion, abort_on_timeout=not probe,
+                                retries=0 if probe else UPLOAD_RETRIES)])
+        return completion.future
+
+    def upload_all(self, node: int, objects: Sequence[tuple[int, int]], timeout: float | None = None,
+                   convert: Callable[[int, bytes], object] | None = None,
+                   on_each: Callable[[int, object], None] | None = None) -> UploadBatch:
+        """Read many objects of one node, back to back, with one future for all (see `UploadBatch`)."""
+        batch = UploadBatch(len(objects), convert, on_each)
+        timeout = timeout or self.timeout
+        self._submit([_Transfer(node, index, sub, timeout, batch, slot, retries=UPLOAD_RETRIES)
+                      for slot, (index, sub) in enumerate(objects)])
+        return batch
 
     def download(self, node: int, index: int, sub: int, data: bytes, timeout: float | None = None,
                  convert: Callable[[None], object] | None = None) -> Future:
         """Write an object; the future gives None (or ``convert(None)``) once the drive confirmed."""
         if not data:
             raise ValueError("an SDO download needs at least one byte")
-        return self._submit(_Transfer(node, index, sub, timeout or self.timeout, download=bytes(data),
-                                      convert=convert))
+        completion = _FutureCompletion(convert)
+        self._submit([_Transfer(node, index, sub, timeout or self.timeout, completion, download=bytes(data))])
+        return completion.future
 
     # -- internals ---------------------------------------------------------------------------------------------
-    def _submit(self, transfer: _Transfer) -> Future:
-        if not 1 <= transfer.node <= 127:
-            raise ValueError(f"node ID {transfer.node} outside 1..127")
+    def _submit(self, transfers: list[_Transfer]) -> None:
+        """Queue transfers (all of one node) and start the first if the node is idle."""
+        if not transfers:
+            return
+        node = transfers[0].node
+        if not 1 <= node <= 127:
+            raise ValueError(f"node ID {node} outside 1..127")
         with self._lock:
-            if transfer.node not in self._queues:
-                self._queues[transfer.node] = deque()
-                self.link.subscribe(SDO_RESPONSE + transfer.node, self._on_response)
-            self._queues[transfer.node].append(transfer)
-            start = transfer.node not in self._active
-            if start:
-                self._start_next(transfer.node)
+            if node not in self._queues:
+                self._queues[node] = deque()
+                self.link.subscribe(SDO_RESPONSE + node, self._on_response)
+            self._queues[node].extend(transfers)
+            if node not in self._active:
+                self._start_next(node)
         self._hand_over()
-        return transfer.future
 
     def _start_next(self, node: int) -> None:
         """Start the next queued transfer of ``node`` (lock held); failures to send complete it at once."""
         queue = self._queues[node]
         while queue:
             transfer = queue.popleft()
-            if not transfer.future.set_running_or_notify_cancel():  # from now on cancel() refuses: the
-                continue                                            # transfer's outcome is always known
+            if not transfer.completion.start(transfer.slot):  # cancelled before it was sent
+                self._finished.append((transfer, CancelledError()))
+                continue
             self._active[node] = transfer
             if self._send(transfer, self._initiate(transfer)):
                 return
@@ -192,7 +291,6 @@ class SdoEngine:
                 self._start_next(node)
             elif not self._send(transfer, follow_up):
                 self._start_next(node)
-        self._hand_over()
 
     def _advance(self, transfer: _Transfer, data: bytes) -> bytes | None:
         """Process one response; return the next request, or None when the transfer is finished."""
@@ -260,34 +358,20 @@ class SdoEngine:
             pass
 
     def _finish(self, transfer: _Transfer, outcome: object) -> None:
-        """End the active transfer of its node (lock held); its future completes in `_hand_over`, after the node's
+        """End the active transfer of its node (lock held); it completes in `_hand_over`, after the node's
         next request has left and the lock is released (conversion and the caller's callbacks then delay neither)."""
         if self._active.get(transfer.node) is transfer:
             del self._active[transfer.node]
         self._finished.append((transfer, outcome))
 
     def _hand_over(self) -> None:
-        """Complete the futures of finished transfers (lock not held)."""
+        """Complete finished transfers (lock not held)."""
         while self._finished:
             try:
                 transfer, outcome = self._finished.popleft()
             except IndexError:  # another thread took the last one
                 return
-            self._complete(transfer, outcome)
-
-    @staticmethod
-    def _complete(transfer: _Transfer, outcome: object) -> None:
-        if transfer.future.done():
-            return
-        if not isinstance(outcome, Exception) and transfer.convert is not None:
-            try:
-                outcome = transfer.convert(outcome)
-            except ValueError as error:
-                outcome = error
-        if isinstance(outcome, Exception):
-            transfer.future.set_exception(outcome)
-        else:
-            transfer.future.set_result(outcome)
+            transfer.completion.done(transfer.slot, outcome)
 
     def _check_timeouts(self, now: float) -> None:
         with self._lock:
@@ -301,6 +385,7 @@ class SdoEngine:
                     continue
                 if transfer.abort_on_timeout:
                     self._abort(transfer, ABORT_TIMEOUT)
+                transfer.completion.drive_silent()
                 sent = " (request sent twice)" if transfer.repeated else ""
                 self._finish(transfer, SdoTimeoutError(
                     transfer.node, transfer.index, transfer.sub,
@@ -318,6 +403,6 @@ class SdoEngine:
                 queue.clear()
             self._active.clear()
             for transfer in pending:
-                if not transfer.future.done():
-                    transfer.future.set_exception(SdoLinkError(
-                        transfer.node, transfer.index, transfer.sub, f"bus {self.link.name} lost: {reason}"))
+                self._finished.append((transfer, SdoLinkError(
+                    transfer.node, transfer.index, transfer.sub, f"bus {self.link.name} lost: {reason}")))
+        self._hand_over()

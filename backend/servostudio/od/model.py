@@ -236,6 +236,7 @@ class ObjectDictionary:
         self._variables = {
             (var.index, var.subindex): var for obj in self._objects.values() for var in obj.subs.values()
         }
+        self._sorted_variables = sorted(self._variables.values(), key=lambda v: v.key)
 
     def __repr__(self) -> str:
         return f"ObjectDictionary({self.device!r}, {len(self._objects)} objects, source={str(self.source)!r})"
@@ -266,7 +267,8 @@ class ObjectDictionary:
         return list(dict.fromkeys(obj.group for obj in self._objects.values() if obj.group))
 
     def variables(self) -> Iterator[Variable]:
-        return iter(sorted(self._variables.values(), key=lambda v: v.key))
+        """Every entry, by index and subindex."""
+        return iter(self._sorted_variables)
 
     def find(self, name: str) -> Variable:
         """Look an entry up by address ("0x6041", "60F9,2", "0x60F9sub2") or by name.

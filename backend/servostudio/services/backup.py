@@ -152,22 +152,28 @@ def backup_file(drive: Drive, path: Path, kind: FileKind | None = None,
 
 def _read_all(drive: Drive, variables: list[Variable], kind: FileKind, progress: Progress | None,
               cancel: Cancellation | None = None) -> tuple[list[ObjectValue], list[dict[str, str]]]:
-    futures = [(var, drive.submit_read(var)) for var in variables]  # all queued: the engine pipelines them
-    reporter = _Reporter(progress, "backup", drive.node, kind.value, len(futures))
-    _wait_all([future for _, future in futures], reporter, cancel)
+    """Read every object in one batch (the engine sends them back to back); this thread waits once, and a
+    cancellation drops the reads not yet sent."""
+    reporter = _Reporter(progress, "backup", drive.node, kind.value, len(variables))
+    batch = drive.submit_read_all(variables, on_each=lambda position, outcome: reporter.step())
+    forget = cancel.on_cancel(batch.cancel) if cancel is not None else None
+    outcomes = batch.future.result()
+    if forget is not None:
+        forget()
     if cancel is not None and cancel.requested:
         raise Cancelled(f"backup of node {drive.node} ({kind.value}) cancelled, no file written")
     values, skipped = [], []
-    for var, future in futures:
-        try:
-            values.append(future.result())
-        except SdoAbortError as error:
-            skipped.append({"object": var.label, "reason": error.reason})
-        except ValueError as error:  # the drive answered bytes that are no value of the object's type
-            skipped.append({"object": var.label, "reason": str(error)})
-        except SdoError as error:
-            _cancel(future for _, future in futures)
-            raise BackupError(f"backup of node {drive.node} ({kind.value}) stopped, no file written: {error}") from None
+    for var, outcome in zip(variables, outcomes):
+        if isinstance(outcome, SdoAbortError):
+            skipped.append({"object": var.label, "reason": outcome.reason})
+        elif isinstance(outcome, SdoError):
+            raise BackupError(f"backup of node {drive.node} ({kind.value}) stopped, no file written: {outcome}")
+        elif isinstance(outcome, ValueError):  # the drive answered bytes that are no value of the object's type
+            skipped.append({"object": var.label, "reason": str(outcome)})
+        elif isinstance(outcome, Exception):
+            raise outcome
+        else:
+            values.append(outcome)
     return values, skipped
 
 
