@@ -209,7 +209,10 @@ class SimulatedNetwork:
                 due = self.clock.next_event_time()
             if behind > MAX_LAG:
                 origin_wall += behind - MAX_LAG  # slip: the host is too slow, virtual time runs slower than real time
-            wait = 0.0 if behind > 0 else IDLE_WAIT if due is None else min(IDLE_WAIT, due - self.clock.now)
+            wait = 0.0
+            if behind <= 0:  # until the next event, counted from now: running the chunk took time too
+                present = origin_virtual + (time.monotonic() - origin_wall)
+                wait = IDLE_WAIT if due is None else min(IDLE_WAIT, due - present)
             for key, _ in self._selector.select(max(wait, 0.0)):
                 key.data()
 
