@@ -143,14 +143,15 @@ class UploadBatch:
 class _Transfer:
     """One SDO transfer and where its state machine stands."""
 
-    __slots__ = ("node", "index", "sub", "timeout", "download", "completion", "slot", "deadline", "received",
-                 "expected_size", "toggle", "offset", "segmented", "abort_on_timeout", "retries", "answered",
-                 "repeated")
+    __slots__ = ("node", "index", "sub", "multiplexer", "timeout", "download", "completion", "slot", "deadline",
+                 "received", "expected_size", "toggle", "offset", "segmented", "abort_on_timeout", "retries",
+                 "answered", "repeated")
 
     def __init__(self, node: int, index: int, sub: int, timeout: float, completion: _FutureCompletion | UploadBatch,
                  slot: int = 0, download: bytes | None = None, abort_on_timeout: bool = True,
                  retries: int = 0) -> None:
         self.node, self.index, self.sub, self.timeout = node, index, sub, timeout
+        self.multiplexer = struct.pack("<HB", index, sub)  # index and subindex as every frame of the transfer has them
         self.download = download  # None: upload
         self.completion, self.slot = completion, slot
         self.deadline = 0.0
@@ -164,16 +165,13 @@ class _Transfer:
         self.answered = False
         self.repeated = False
 
-    def multiplexer(self) -> bytes:
-        return struct.pack("<HB", self.index, self.sub)
-
 
 def _stale(transfer: _Transfer, data: bytes) -> bool:
     """An answer that belongs to an earlier request: a late reply about another object (after a timeout), or a
     second reply to a repeated initiate request while the segments are already running."""
     command = data[0]
     initiate_reply = command >> 5 in (2, 3)
-    if (initiate_reply or command == 0x80) and data[1:4] != transfer.multiplexer():
+    if (initiate_reply or command == 0x80) and data[1:4] != transfer.multiplexer:
         return True
     in_segments = transfer.offset > 0 if transfer.download is not None else transfer.segmented
     return initiate_reply and in_segments
@@ -258,12 +256,12 @@ class SdoEngine:
     def _initiate(self, transfer: _Transfer) -> bytes:
         data = transfer.download
         if data is None:
-            return bytes([0x40]) + transfer.multiplexer() + bytes(4)
+            return bytes([0x40]) + transfer.multiplexer + bytes(4)
         if len(data) <= 4:
             command = 0x23 | ((4 - len(data)) << 2)
-            return bytes([command]) + transfer.multiplexer() + data.ljust(4, b"\0")
+            return bytes([command]) + transfer.multiplexer + data.ljust(4, b"\0")
         transfer.segmented = True
-        return bytes([0x21]) + transfer.multiplexer() + struct.pack("<I", len(data))
+        return bytes([0x21]) + transfer.multiplexer + struct.pack("<I", len(data))
 
     def _send(self, transfer: _Transfer, frame: bytes) -> bool:
         """Send one request of the active transfer; on a dead link fail it (lock held) and report False."""
@@ -304,7 +302,7 @@ class SdoEngine:
 
     def _advance_upload(self, transfer: _Transfer, command: int, data: bytes) -> bytes | None:
         if not transfer.segmented:
-            self._expect(transfer, command >> 5 == 2 and data[1:4] == transfer.multiplexer(), data)
+            self._expect(transfer, command >> 5 == 2 and data[1:4] == transfer.multiplexer, data)
             if command & 0x02:  # expedited
                 size = 4 - ((command >> 2) & 0x3) if command & 0x01 else 4
                 self._finish(transfer, bytes(data[4 : 4 + size]))
@@ -328,7 +326,7 @@ class SdoEngine:
         payload = transfer.download
         assert payload is not None
         if transfer.offset == 0 and command >> 5 == 3:
-            self._expect(transfer, data[1:4] == transfer.multiplexer(), data)
+            self._expect(transfer, data[1:4] == transfer.multiplexer, data)
             if not transfer.segmented:
                 self._finish(transfer, None)
                 return None
@@ -352,7 +350,7 @@ class SdoEngine:
 
     def _abort(self, transfer: _Transfer, code: int) -> None:
         try:
-            frame = bytes([0x80]) + transfer.multiplexer() + struct.pack("<I", code)
+            frame = bytes([0x80]) + transfer.multiplexer + struct.pack("<I", code)
             self.link.send(SDO_REQUEST + transfer.node, frame)
         except LinkDownError:
             pass
