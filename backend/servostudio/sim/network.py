@@ -4,8 +4,12 @@ Two ways to run time:
 - tests call `advance(seconds)`: deterministic, as fast as the host allows;
 - servers call `start()`: a background thread paces virtual time against the monotonic wall clock. It runs the
   events due in chunks of at most `CHUNK` virtual seconds, taking `lock` for one chunk at a time, and waits until
-  the next event is due or a client's socket has data. When the host cannot keep up, virtual time stays at most
-  `MAX_LAG` behind the wall clock: it slips (runs slower than real time) instead of catching up in a burst.
+  the next event is due or a client's socket has data. The drives' control periods are lazy events (see
+  `servostudio.sim.clock`): they run in order with the rest, but the thread wakes for them only every `IDLE_WAIT`
+  when nothing else is due, so a frame a control period produces (a TPDO, an EMCY) may reach the clients up to that
+  late in wall-clock time, with its exact virtual time stamp (as a USB CAN adapter delivers in 1 ms packets). When
+  the host cannot keep up, virtual time stays at most `MAX_LAG` behind the wall clock: it slips (runs slower than
+  real time) instead of catching up in a burst.
 All access to the simulation goes through `lock`. Frames and actions from other threads enter with `inject` /
 `post`: while the thread runs they wait in a queue that it empties after every chunk, so a client's frame never
 waits for the lock behind a catch-up and enters the bus at the simulation's present.
@@ -137,7 +141,7 @@ class SimulatedNetwork:
             )
         self._ticks = 0
         self._node_list = list(self.nodes.values())
-        self.clock.call_at(CONTROL_PERIOD, self._tick)
+        self.clock.call_at(CONTROL_PERIOD, self._tick, lazy=True)
         self._thread: threading.Thread | None = None
         self._stop = threading.Event()
         self._posted: deque[Callable[[], None]] = deque()
@@ -161,7 +165,8 @@ class SimulatedNetwork:
 
     def _tick(self) -> None:
         self._ticks += 1
-        self.clock.call_at((self._ticks + 1) * CONTROL_PERIOD, self._tick)  # first, so a failing step cannot stop time
+        # Scheduled first, so a failing step cannot stop time.
+        self.clock.call_at((self._ticks + 1) * CONTROL_PERIOD, self._tick, lazy=True)
         for node in self._node_list:
             node.step(CONTROL_PERIOD)
 
