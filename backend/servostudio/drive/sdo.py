@@ -134,10 +134,12 @@ class UploadBatch:
             self._outcomes[slot] = outcome
             self._left -= 1
             last = self._left == 0
-        if self._on_each is not None:
-            self._on_each(slot, outcome)
-        if last:
-            self.future.set_result(self._outcomes)
+        try:
+            if self._on_each is not None:
+                self._on_each(slot, outcome)
+        finally:  # a failing callback must not leave the caller waiting forever
+            if last:
+                self.future.set_result(self._outcomes)
 
 
 class _Transfer:

@@ -272,26 +272,26 @@ class SimulatedNetwork:
 
     def watch(self, connection: socket.socket, on_readable: Callable[[], None]) -> None:
         """Call `on_readable()` on the simulation thread (lock not held) whenever `connection` has data, until
-        `unwatch`. It should read without blocking and hand frames to `inject`. Sockets are served while the
+        `unwatch_and_close`. It should read without blocking and hand frames to `inject`. Sockets are served while the
         network runs (`start()`); `advance()` does not read them."""
         connection.setblocking(False)
         descriptor = connection.fileno()
         self.post(lambda: self._selector.register(descriptor, selectors.EVENT_READ, on_readable))
 
-    def unwatch(self, connection: socket.socket) -> None:
-        """Stop watching `connection`; call it before closing the socket. The descriptor is forgotten in posting
-        order, so a new connection that reuses the number after the close is registered after it."""
+    def unwatch_and_close(self, connection: socket.socket) -> None:
+        """Stop watching `connection` and close it, on the simulation thread: a descriptor closed while `select`
+        still waits on it would fail the wait. In posting order, so a new connection that reuses the number is
+        registered after this."""
         descriptor = connection.fileno()
-        if descriptor < 0:
-            return
 
-        def forget() -> None:
+        def forget_and_close() -> None:
             try:
                 self._selector.unregister(descriptor)
-            except KeyError:
+            except (KeyError, ValueError):  # never registered, or already closed
                 pass
+            connection.close()
 
-        self.post(forget)
+        self.post(forget_and_close)
 
     def _wake(self) -> None:
         try:

@@ -104,13 +104,12 @@ class _Session:
         self._closed.set()
         if self._attached:
             self.server.network.detach(self)
-        self.server.network.unwatch(self.connection)
         self._output.put(None)
         try:
             self.connection.shutdown(socket.SHUT_RDWR)
         except OSError:
             pass
-        self.connection.close()
+        self.server.network.unwatch_and_close(self.connection)
         self.server._forget(self)
 
     # -- station --------------------------------------------------------------------------------------------------
