@@ -43,6 +43,16 @@ class EmcyLayout(str, enum.Enum):
     UNUSED = "unused"
 
 
+@dataclass(frozen=True)
+class Addressing:
+    """The node IDs a device can take, and why (the text goes into error messages)."""
+
+    node_ids: range = range(1, 128)
+    reason: str = "CANopen node IDs are 1-127"
+    #: the device also serves SDO as node n + offset: no other node on its bus may use that ID
+    redirect_offset: int | None = None
+
+
 class ProfileError(KeyError):
     """The device has no object or signature of that semantic name."""
 
@@ -80,6 +90,7 @@ class DeviceProfile:
     parameter_files: Mapping[str, SaveType] = field(default_factory=lambda: {"DRIVEPAR.TXT": SaveType.DRIVEPAR})
     #: the sequence file is read through the sequence objects (XtrapulsPac)
     has_sequences: bool = False
+    addressing: Addressing = Addressing()
 
     def address(self, name: str) -> tuple[int, int]:
         try:

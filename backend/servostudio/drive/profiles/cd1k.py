@@ -6,7 +6,7 @@ Source: /work/shared/spec/cd1k-canopen.md §2.6 (seed L546–579).  Bits 16–18
 from __future__ import annotations
 
 from servostudio.drive.faults import FaultInfo
-from servostudio.drive.profiles.base import CIA301_OBJECTS, CIA402_OBJECTS, DeviceProfile, EmcyLayout
+from servostudio.drive.profiles.base import CIA301_OBJECTS, CIA402_OBJECTS, Addressing, DeviceProfile, EmcyLayout
 
 _ERRORS = {info.code: info for info in (
     FaultInfo(1, 0, "Position limits", ""),
@@ -40,4 +40,5 @@ CD1K = DeviceProfile(
     errors=_ERRORS,
     emcy_layout=EmcyLayout.BITFIELD,
     save_needs_disabled=True,
+    addressing=Addressing(reason="CD1-k node IDs are 1-127 (switches)"),
 )

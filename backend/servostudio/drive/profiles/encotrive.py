@@ -6,7 +6,7 @@ Source: /work/shared/spec/encotrive-canopen.md §2.6 (the manufacturer EMCY byte
 from __future__ import annotations
 
 from servostudio.drive.faults import FaultInfo
-from servostudio.drive.profiles.base import CIA301_OBJECTS, CIA402_OBJECTS, DeviceProfile
+from servostudio.drive.profiles.base import CIA301_OBJECTS, CIA402_OBJECTS, Addressing, DeviceProfile
 
 _EMCY = {info.cia402_code: info for info in (
     FaultInfo(0, 0x4280, "CPU-board temperature sensor failed", "The drive switched off; reset with control word bit 7 "
@@ -33,4 +33,5 @@ ENCOTRIVE = DeviceProfile(
     objects={**CIA301_OBJECTS, **CIA402_OBJECTS, "error_history": (0x1003, 1)},
     signatures={"save": ("store_parameters", "save"), "load": ("restore_parameters", "load")},
     emcy_codes=_EMCY,
+    addressing=Addressing(reason="encoTRive node IDs are 1-127"),
 )

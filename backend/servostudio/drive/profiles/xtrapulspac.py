@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from servostudio.drive.profiles.base import CIA301_OBJECTS, CIA402_OBJECTS, DeviceProfile, EmcyLayout
+from servostudio.drive.profiles.base import CIA301_OBJECTS, CIA402_OBJECTS, Addressing, DeviceProfile, EmcyLayout
 from servostudio.drive.profiles.xtrapulspac_faults import ERRORS, WARNINGS
 from servostudio.od.model import SaveType
 
@@ -35,4 +35,9 @@ XTRAPULSPAC = DeviceProfile(
     emcy_layout=EmcyLayout.CODE_BYTE,
     parameter_files={"DRIVEPAR.TXT": SaveType.DRIVEPAR, "USER_PAR.TXT": SaveType.USER_PAR},
     has_sequences=True,
+    addressing=Addressing(
+        range(1, 64),
+        "XtrapulsPac node IDs are 1-63 (front-panel switches); n+64 is its redirected SDO channel (manual L2565-2589)",
+        redirect_offset=64,
+    ),
 )

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from collections.abc import Collection
 
-from servostudio.services.projects.devices import addressing
+from servostudio.drive.profiles import profile_for
 from servostudio.transport.spec import BusSpecError, parse_bus_spec
 from servostudio.services.projects.errors import ValidationError
 from servostudio.services.projects.model import Axis, Project
@@ -45,7 +45,7 @@ def _check_axis(axis: Axis, project: Project, known_devices: Collection[str]) ->
     if project.bus(axis.bus) is None:
         buses = ", ".join(bus.name for bus in project.buses) or "none defined"
         raise ValidationError(f"axis '{axis.name}': unknown bus '{axis.bus}' (buses: {buses})")
-    rules = addressing(axis.device)
+    rules = profile_for(axis.device).addressing
     if axis.node_id not in rules.node_ids:
         raise ValidationError(
             f"axis '{axis.name}': node ID {axis.node_id} is out of range "
@@ -61,7 +61,7 @@ def _check_bus_addresses(bus: str, axes: list[Axis]) -> None:
                                   f"axis '{owner[axis.node_id]}'")
         owner[axis.node_id] = axis.name
     for axis in axes:
-        offset = addressing(axis.device).redirect_offset
+        offset = profile_for(axis.device).addressing.redirect_offset
         if offset is not None and axis.node_id + offset in owner:
             raise ValidationError(
                 f"axis '{owner[axis.node_id + offset]}': node ID {axis.node_id + offset} on bus '{bus}' is reserved by "
