@@ -71,14 +71,25 @@ class MotionGuard:
             for axes in self._owned.values():
                 axes.discard(axis)
 
-    def disconnect(self, client: str, manager: ConnectionManager) -> list[Axis]:
-        """The client is gone: quick-stop every axis it owns; returns them."""
+    def disconnect(self, client: str, manager: ConnectionManager) -> threading.Thread | None:
+        """The client is gone: quick-stop every axis it owns, on a thread of its own (returned, already started;
+        None when it owned none).
+
+        Not on the event loop's executor: the socket handler calling this may itself be cancelled (server shutdown,
+        a test client tearing its loop down), and the axes must stop all the same."""
         with self._lock:
             axes = sorted(self._owned.pop(client, set()))
+        if not axes:
+            return None
+        stopper = threading.Thread(target=self._quick_stop, args=(client, axes, manager), name=f"motion-stop {client}")
+        stopper.start()
+        return stopper
+
+    @staticmethod
+    def _quick_stop(client: str, axes: list[Axis], manager: ConnectionManager) -> None:
         for bus, node in axes:
             try:
                 set_state(manager.get(bus).drive(node), State.QUICK_STOP_ACTIVE)
                 log.warning("client %s went away: quick stop of node %d on bus %s", client, node, bus)
             except (LookupError, StateChangeError, SdoError, LinkDownError, ValueError) as error:
                 log.error("client %s went away: quick stop of node %d on bus %s failed: %s", client, node, bus, error)
-        return axes

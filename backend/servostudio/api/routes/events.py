@@ -51,7 +51,7 @@ async def events_socket(socket: WebSocket, types: str | None = None, user: User 
     finally:
         subscription.close()
         receiver.cancel()
-        await asyncio.to_thread(motion.disconnect, client, manager)
+        motion.disconnect(client, manager)  # returns at once: the quick stops run on their own thread
 
 
 async def _drain(socket: WebSocket) -> None:
