@@ -3,6 +3,9 @@ talk to the simulated drives (what `servostudio serve` uses by default).
 
 Frames a client sends enter the virtual bus at the current virtual time; frames on the bus are queued for the
 client with their virtual timestamps. A remote frame (`is_remote_frame`) stays a remote frame.
+
+Besides python-can's `recv`/`send`, the bus offers `receive_frames` (every queued data frame at once, as plain
+tuples) and `send_frame`, which the communication server's bus link uses on its hot path.
 """
 
 from __future__ import annotations
@@ -66,8 +69,24 @@ class SimulatedCanBus(can.BusABC):
         except queue.Empty:
             return None, False
 
+    def receive_frames(self, timeout: float | None) -> list[tuple[int, bytes, float, bool]]:
+        """(identifier, data, timestamp, extended) of every data frame queued, waiting up to `timeout` for one."""
+        messages = []
+        try:
+            messages.append(self._received.get(timeout=timeout))
+            while True:
+                messages.append(self._received.get_nowait())
+        except queue.Empty:
+            pass
+        return [(message.arbitration_id, bytes(message.data), message.timestamp, message.is_extended_id)
+                for message in messages if not message.is_remote_frame]
+
     def send(self, msg: can.Message, timeout: float | None = None) -> None:
         self._network.inject(from_message(msg), sender=self)
+
+    def send_frame(self, cob_id: int, data: bytes) -> None:
+        """A standard data frame, without building a python-can Message."""
+        self._network.inject(Frame(cob_id, bytes(data)), sender=self)
 
     def shutdown(self) -> None:
         self._network.detach(self)
