@@ -21,7 +21,7 @@ second thread, which on a loaded host costs more than the frame itself.
 from __future__ import annotations
 
 import logging
-import selectors
+import select
 import socket
 import threading
 import time
@@ -145,12 +145,8 @@ class SimulatedNetwork:
         self._thread: threading.Thread | None = None
         self._stop = threading.Event()
         self._posted: deque[Callable[[], None]] = deque()
-        self._selector = selectors.SelectSelector()  # select() waits to the microsecond; epoll and poll round up to
-        # whole milliseconds, longer than an SDO frame
-        self._wake_in, self._wake_out = socket.socketpair()
-        for end in (self._wake_in, self._wake_out):
-            end.setblocking(False)
-        self._selector.register(self._wake_in, selectors.EVENT_READ, self._drain_wake)
+        self._readers: dict[int, Callable[[], None]] = {}  # watched descriptor -> its callback
+        self._wake_pair: tuple[socket.socket, socket.socket] | None = None  # (read end, write end) while running
 
     # -- nodes ----------------------------------------------------------------------------------------------------
 
@@ -191,6 +187,9 @@ class SimulatedNetwork:
         if self.running:
             return
         self._stop.clear()
+        self._wake_pair = socket.socketpair()
+        for end in self._wake_pair:
+            end.setblocking(False)
         self._thread = threading.Thread(target=self._run, name="sim-clock", daemon=True)
         self._thread.start()
 
@@ -200,6 +199,10 @@ class SimulatedNetwork:
         if self._thread is not None:
             self._thread.join()
             self._thread = None
+        if self._wake_pair is not None:
+            for end in self._wake_pair:
+                end.close()
+            self._wake_pair = None
         with self.lock:
             self._run_posted()  # frames that arrived while the thread was ending
 
@@ -218,8 +221,18 @@ class SimulatedNetwork:
             if behind <= 0:  # until the next event, counted from now: running the chunk took time too
                 present = origin_virtual + (time.monotonic() - origin_wall)
                 wait = IDLE_WAIT if due is None else min(IDLE_WAIT, due - present)
-            for key, _ in self._selector.select(max(wait, 0.0)):
-                key.data()
+            self._wait_for_readers(max(wait, 0.0))
+
+    def _wait_for_readers(self, seconds: float) -> None:
+        """Wait up to `seconds` for a watched socket or a wake-up, and serve what is readable. `select` waits to the
+        microsecond; epoll and poll round up to whole milliseconds, longer than an SDO frame."""
+        wake = self._wake_pair[0]
+        readable, _, _ = select.select([wake, *self._readers], [], [], seconds)
+        for descriptor in readable:
+            if descriptor is wake:
+                self._drain_wake()
+            elif descriptor in self._readers:
+                self._readers[descriptor]()
 
     def _run_chunk(self, until: float) -> None:
         """Events due up to `until`, then the frames posted meanwhile (lock held); a failing event is dropped."""
@@ -276,32 +289,36 @@ class SimulatedNetwork:
         network runs (`start()`); `advance()` does not read them."""
         connection.setblocking(False)
         descriptor = connection.fileno()
-        self.post(lambda: self._selector.register(descriptor, selectors.EVENT_READ, on_readable))
+
+        def register() -> None:
+            self._readers[descriptor] = on_readable
+
+        self.post(register)
 
     def unwatch_and_close(self, connection: socket.socket) -> None:
         """Stop watching `connection` and close it, on the simulation thread: a descriptor closed while `select`
         still waits on it would fail the wait. In posting order, so a new connection that reuses the number is
-        registered after this."""
+        watched after this."""
         descriptor = connection.fileno()
 
         def forget_and_close() -> None:
-            try:
-                self._selector.unregister(descriptor)
-            except (KeyError, ValueError):  # never registered, or already closed
-                pass
+            self._readers.pop(descriptor, None)
             connection.close()
 
         self.post(forget_and_close)
 
     def _wake(self) -> None:
+        pair = self._wake_pair
+        if pair is None:
+            return
         try:
-            self._wake_out.send(b"\0")
-        except BlockingIOError:  # plenty of wake-ups are pending already
+            pair[1].send(b"\0")
+        except (BlockingIOError, OSError):  # plenty of wake-ups pending, or stopping: the thread wakes anyway
             pass
 
     def _drain_wake(self) -> None:
         try:
-            while self._wake_in.recv(4096):
+            while self._wake_pair[0].recv(4096):
                 pass
         except BlockingIOError:
             pass
