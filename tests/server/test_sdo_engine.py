@@ -182,3 +182,19 @@ def test_a_drive_that_stops_answering_ends_the_batch_at_the_first_silent_read(en
     outcomes = engine.upload_all(9, [(0x1000, 0)] * 50).future.result(10)
     assert isinstance(outcomes[0], SdoTimeoutError)
     assert all(isinstance(outcome, CancelledError) for outcome in outcomes[1:])
+
+
+def test_a_batch_of_writes_reaches_the_drive_in_order(engine, slaves):
+    writes = [(0x2003, 0, (1).to_bytes(4, "little")), (0x2FFF, 0, b"\x01"), (0x2004, 0, b"a long new axis name"),
+              (0x2003, 0, (2).to_bytes(4, "little"))]
+    outcomes = engine.download_all(1, writes, convert=lambda position, _: position).future.result(5)
+    assert outcomes[0] == 0 and outcomes[2] == 2 and outcomes[3] == 3
+    assert isinstance(outcomes[1], SdoAbortError) and outcomes[1].code == 0x06020000
+    assert slaves[1].sdo[0x2003].raw == 2  # the later write of the same object came later
+    assert slaves[1].sdo[0x2004].raw == "a long new axis name"
+
+
+def test_a_batch_write_without_data_is_refused_before_anything_is_sent(engine, slaves):
+    with pytest.raises(ValueError, match="at least one byte"):
+        engine.download_all(1, [(0x2003, 0, (5).to_bytes(4, "little")), (0x2001, 0, b"")])
+    assert slaves[1].sdo[0x2003].raw != 5

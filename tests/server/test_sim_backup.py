@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import threading
 import time
 
 import pytest
@@ -139,3 +140,38 @@ def test_link_cut_during_restore_says_what_was_written(connection, endpoint, sim
         time.sleep(0.05)
     rerun = restore_file(drive, path)  # a failed restore can simply be run again
     assert rerun.ok, rerun.as_dict()
+
+
+def test_a_drive_that_stops_answering_ends_the_restore_at_its_first_silent_write(connection, sim_network, slow,
+                                                                                 tmp_path):
+    """The bus stays up but node 3 goes silent (NMT stop) early in a restore: one write times out and the rest of
+    the file is not sent at all (not one timeout per object); the result says what was written."""
+    drive = connection.drive(3)
+    path = tmp_path / "DRIVEPAR.TXT"
+    backup_file(drive, path)
+    silent = threading.Event()
+    sent_while_silent = []
+
+    def spy_receive(self, frame, timestamp):
+        if silent.is_set() and frame.can_id in (0x603, 0x643) and frame.data[0] & 0xE0 == 0x20:
+            sent_while_silent.append(frame)  # a download request to node 3 (direct or redirected)
+
+    def progress(event):
+        if event["done"] > 0 and not silent.is_set():
+            sim_network.post(lambda: sim_network.node(3).nmt_command(0x02))  # stop: no more SDO answers
+            silent.set()
+
+    station = type("Spy", (), {"receive": spy_receive})()
+    sim_network.attach(station)
+    try:
+        with slow(sim_network):
+            result = restore_file(drive, path, progress=progress)
+    finally:
+        sim_network.detach(station)
+        sim_network.post(lambda: sim_network.node(3).nmt_command(0x80))  # back to pre-operational
+    assert not result.ok and "no SDO response" in result.error
+    assert "objects had been written; nothing was stored to flash" in result.error
+    assert 1 <= len(sent_while_silent) <= 3, len(sent_while_silent)
+    statuses = [outcome.status for outcome in result.outcomes]
+    assert statuses.count("not written") > len(statuses) / 2 and "written" in statuses
+    assert restore_file(drive, path).ok  # the node answers again: the same file simply goes in

@@ -5,8 +5,8 @@ value fit its type, range and enumeration — is made before a frame is sent, an
 object.  The drive's own refusals arrive as SDO aborts translated by ``servostudio.drive.sdo``.
 
 Methods block the calling thread (they wait on the SDO engine); the ``submit_*`` variants return futures so
-many reads can be queued at once and awaited from asyncio with ``asyncio.wrap_future``; ``submit_read_all`` reads a
-whole list (a backup) with one future.
+many reads can be queued at once and awaited from asyncio with ``asyncio.wrap_future``; ``submit_read_all`` and
+``submit_write_all`` transfer a whole list (a backup, a restore) with one future.
 """
 
 from __future__ import annotations
@@ -15,7 +15,7 @@ from collections.abc import Callable, Sequence
 from concurrent.futures import Future
 
 from servostudio.drive.profiles import DeviceProfile, profile_for
-from servostudio.drive.sdo import SdoEngine, UploadBatch
+from servostudio.drive.sdo import SdoEngine, TransferBatch
 from servostudio.drive.values import ObjectValue, Raw, decode_raw, parse_input
 from servostudio.od.datatypes import DataType, encode
 from servostudio.od.model import Access, ObjectDictionary, Variable
@@ -72,9 +72,9 @@ class Drive:
                                   convert=lambda data: ObjectValue(self.node, variable, decode_raw(variable, data)))
 
     def submit_read_all(self, variables: Sequence[Variable],
-                        on_each: Callable[[int, ObjectValue | Exception], None] | None = None) -> UploadBatch:
+                        on_each: Callable[[int, ObjectValue | Exception], None] | None = None) -> TransferBatch:
         """Queue reads of many objects at once; the batch's future gives, in order, an ObjectValue or the exception
-        that ended each read (see `UploadBatch`)."""
+        that ended each read (see `TransferBatch`)."""
         for variable in variables:
             if not variable.access.readable:
                 raise DriveAccessError(f"node {self.node}: {variable.label} is write-only")
@@ -109,6 +109,16 @@ class Drive:
         variable, raw, data = self.prepare_write(key, value, physical)
         return self.engine.download(self.node, variable.index, variable.subindex, data, timeout,
                                     convert=lambda _: ObjectValue(self.node, variable, raw))
+
+    def submit_write_all(self, writes: Sequence[tuple[Variable, object]],
+                         on_each: Callable[[int, ObjectValue | Exception], None] | None = None) -> TransferBatch:
+        """Check every write, then queue them all (nothing is sent if one fails its check); the batch's future
+        gives, in order, the ObjectValue written or the exception that ended each write (see `TransferBatch`)."""
+        prepared = [self.prepare_write(variable, value) for variable, value in writes]
+        return self.engine.download_all(
+            self.node, [(variable.index, variable.subindex, data) for variable, _, data in prepared],
+            convert=lambda position, _: ObjectValue(self.node, prepared[position][0], prepared[position][1]),
+            on_each=on_each)
 
     def write(self, key: str | tuple[int, int] | Variable, value: object, physical: bool = False,
               timeout: float | None = None) -> ObjectValue:

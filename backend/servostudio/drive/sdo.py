@@ -91,14 +91,15 @@ class _FutureCompletion:
             self.future.set_result(outcome)
 
 
-class UploadBatch:
-    """Reads of many objects of one node with one future for all: ``future`` gives a list, in request order, of
-    each value (``convert(position, bytes)`` when given) or the exception that ended its read.
+class TransferBatch:
+    """Reads (or writes) of many objects of one node with one future for all: ``future`` gives a list, in request
+    order, of each result — the bytes read or None for a write, passed through ``convert(position, result)`` when
+    given — or the exception that ended that transfer.
 
     A backup reads hundreds of objects; one future per object would cost more client time than the frames.
-    ``on_each(position, outcome)`` runs as each read ends (on the bus reader thread: keep it short).
-    ``cancel()`` drops the reads not yet sent; their outcome is a ``CancelledError``. A read that times out drops
-    the rest the same way: a drive that stopped answering would otherwise cost a timeout per object.
+    ``on_each(position, outcome)`` runs as each transfer ends (on the bus reader thread: keep it short).
+    ``cancel()`` drops the transfers not yet sent; their outcome is a ``CancelledError``. A transfer that times out
+    drops the rest the same way: a drive that stopped answering would otherwise cost a timeout per object.
     """
 
     def __init__(self, count: int, convert: Callable[[int, bytes], object] | None = None,
@@ -121,7 +122,7 @@ class UploadBatch:
         return not self._cancelled
 
     def drive_silent(self) -> None:
-        """A read timed out: the drive stopped answering, the reads still queued are dropped."""
+        """A transfer timed out: the drive stopped answering, the transfers still queued are dropped."""
         self._cancelled = True
 
     def done(self, slot: int, outcome: object) -> None:
@@ -149,7 +150,7 @@ class _Transfer:
                  "received", "expected_size", "toggle", "offset", "segmented", "abort_on_timeout", "retries",
                  "answered", "repeated")
 
-    def __init__(self, node: int, index: int, sub: int, timeout: float, completion: _FutureCompletion | UploadBatch,
+    def __init__(self, node: int, index: int, sub: int, timeout: float, completion: _FutureCompletion | TransferBatch,
                  slot: int = 0, download: bytes | None = None, abort_on_timeout: bool = True,
                  retries: int = 0) -> None:
         self.node, self.index, self.sub, self.timeout = node, index, sub, timeout
@@ -208,12 +209,24 @@ class SdoEngine:
 
     def upload_all(self, node: int, objects: Sequence[tuple[int, int]], timeout: float | None = None,
                    convert: Callable[[int, bytes], object] | None = None,
-                   on_each: Callable[[int, object], None] | None = None) -> UploadBatch:
-        """Read many objects of one node, back to back, with one future for all (see `UploadBatch`)."""
-        batch = UploadBatch(len(objects), convert, on_each)
+                   on_each: Callable[[int, object], None] | None = None) -> TransferBatch:
+        """Read many objects of one node, back to back, in order, with one future for all (see `TransferBatch`)."""
+        batch = TransferBatch(len(objects), convert, on_each)
         timeout = timeout or self.timeout
         self._submit([_Transfer(node, index, sub, timeout, batch, slot, retries=UPLOAD_RETRIES)
                       for slot, (index, sub) in enumerate(objects)])
+        return batch
+
+    def download_all(self, node: int, writes: Sequence[tuple[int, int, bytes]], timeout: float | None = None,
+                     convert: Callable[[int, None], object] | None = None,
+                     on_each: Callable[[int, object], None] | None = None) -> TransferBatch:
+        """Write many objects of one node, back to back, in order, with one future for all (see `TransferBatch`)."""
+        if any(not data for _, _, data in writes):
+            raise ValueError("an SDO download needs at least one byte")
+        batch = TransferBatch(len(writes), convert, on_each)
+        timeout = timeout or self.timeout
+        self._submit([_Transfer(node, index, sub, timeout, batch, slot, download=bytes(data))
+                      for slot, (index, sub, data) in enumerate(writes)])
         return batch
 
     def download(self, node: int, index: int, sub: int, data: bytes, timeout: float | None = None,

@@ -21,13 +21,13 @@ import struct
 import threading
 import time
 from collections.abc import Callable, Iterable
-from concurrent.futures import Future, ThreadPoolExecutor, wait
+from concurrent.futures import CancelledError, Future, ThreadPoolExecutor, wait
 from dataclasses import dataclass, field
 from pathlib import Path
 
 from servostudio.drive.access import Drive, DriveAccessError
 from servostudio.drive.cia402 import State, decode_state
-from servostudio.drive.sdo import SdoAbortError, SdoError
+from servostudio.drive.sdo import SdoAbortError, SdoError, TransferBatch
 from servostudio.drive.values import ObjectValue
 from servostudio.formats.objectfile import ObjectEntry, ObjectFileError, read_object_file, write_object_file
 from servostudio.formats.sequence import SequenceFileError, SequenceTable, read_sequence_file, write_sequence_file
@@ -155,11 +155,8 @@ def _read_all(drive: Drive, variables: list[Variable], kind: FileKind, progress:
     """Read every object in one batch (the engine sends them back to back); this thread waits once, and a
     cancellation drops the reads not yet sent."""
     reporter = _Reporter(progress, "backup", drive.node, kind.value, len(variables))
-    batch = drive.submit_read_all(variables, on_each=lambda position, outcome: reporter.step())
-    forget = cancel.on_cancel(batch.cancel) if cancel is not None else None
-    outcomes = batch.future.result()
-    if forget is not None:
-        forget()
+    outcomes = _wait_batch(drive.submit_read_all(variables, on_each=lambda position, outcome: reporter.step()),
+                           cancel)
     if cancel is not None and cancel.requested:
         raise Cancelled(f"backup of node {drive.node} ({kind.value}) cancelled, no file written")
     values, skipped = [], []
@@ -177,18 +174,15 @@ def _read_all(drive: Drive, variables: list[Variable], kind: FileKind, progress:
     return values, skipped
 
 
-def _wait_all(futures: list[Future], reporter: _Reporter, cancel: Cancellation | None = None) -> None:
-    """Wait once for all transfers, counting progress as they complete; a cancellation drops those not started.
+def _wait_all(futures: list[Future], reporter: _Reporter) -> None:
+    """Wait once for all transfers (a sequence file's mixed writes and reads), counting progress as they complete.
 
     Waiting on each future in turn would wake this thread once per object, competing with the bus reader for
     the interpreter on every answer; here only the reader thread runs until the last answer.
     """
     for future in futures:
         future.add_done_callback(reporter.step_done)
-    forget = cancel.on_cancel(lambda: _cancel(futures)) if cancel is not None else None
     wait(futures)
-    if forget is not None:
-        forget()
 
 
 def _file_value(value: ObjectValue) -> int | str:
@@ -341,43 +335,44 @@ def _write_and_verify(drive: Drive, writes: list[tuple[Variable, object]], kind:
     reporter = _Reporter(progress, "restore", drive.node, kind.value, 2 * len(writes))
     pending = list(range(len(writes)))
     for _ in range(2):  # one rewrite pass for values that a later write changed
-        write_futures = [(index, drive.submit_write(writes[index][0], writes[index][1])) for index in pending]
-        _wait_all([future for _, future in write_futures], reporter, cancel)
+        written = _wait_batch(drive.submit_write_all([writes[index] for index in pending],
+                                                     on_each=lambda position, outcome: reporter.step()), cancel)
         link_error: SdoError | None = None
-        for index, future in write_futures:
-            if future.cancelled():
-                continue  # dropped by a cancellation before it was sent: stays "not written"
-            try:
-                future.result()
+        for index, outcome in zip(pending, written):
+            if isinstance(outcome, CancelledError):
+                continue  # dropped (cancelled, or the drive stopped answering) before it was sent: "not written"
+            if isinstance(outcome, SdoAbortError):
+                outcomes[index].status, outcomes[index].error = "failed", outcome.reason
+            elif isinstance(outcome, SdoError):
+                link_error = link_error or outcome
+            elif isinstance(outcome, Exception):
+                raise outcome
+            else:
                 outcomes[index].status, outcomes[index].error = "written", ""
-            except SdoAbortError as error:
-                outcomes[index].status, outcomes[index].error = "failed", error.reason
-            except SdoError as error:
-                link_error = link_error or error
         if link_error is not None:
-            raise_with = _partial(drive, outcomes, link_error)
-            raise raise_with
+            raise _partial(drive, outcomes, link_error)
         if cancel is not None and cancel.requested:
             raise _cancelled(drive, outcomes)
         readable = [index for index in pending if outcomes[index].status == "written"
                     and writes[index][0].access.readable]
-        read_futures = [(index, drive.submit_read(writes[index][0])) for index in readable]
-        _wait_all([future for _, future in read_futures], reporter, cancel)
+        read_back = _wait_batch(drive.submit_read_all([writes[index][0] for index in readable],
+                                                      on_each=lambda position, outcome: reporter.step()), cancel)
         mismatched = []
-        for index, future in read_futures:
-            if future.cancelled():
+        for index, outcome in zip(readable, read_back):
+            if isinstance(outcome, CancelledError):
                 continue
-            try:
-                value = future.result().raw
-            except SdoError as error:
-                if not isinstance(error, SdoAbortError):
-                    raise _partial(drive, outcomes, error) from None
-                outcomes[index].status, outcomes[index].error = "failed", f"read back: {error.reason}"
-                continue
-            if _same(value, writes[index][1]):
+            if isinstance(outcome, SdoAbortError):
+                outcomes[index].status, outcomes[index].error = "failed", f"read back: {outcome.reason}"
+            elif isinstance(outcome, SdoError):
+                raise _partial(drive, outcomes, outcome)
+            elif isinstance(outcome, ValueError):  # bytes that are no value of the object's type
+                outcomes[index].status, outcomes[index].error = "failed", f"read back: {outcome}"
+            elif isinstance(outcome, Exception):
+                raise outcome
+            elif _same(outcome.raw, writes[index][1]):
                 outcomes[index].status = "verified"
             else:
-                outcomes[index].status, outcomes[index].error = "failed", f"read back {_shown(value)}"
+                outcomes[index].status, outcomes[index].error = "failed", f"read back {_shown(outcome.raw)}"
                 mismatched.append(index)
         if cancel is not None and cancel.requested:
             raise _cancelled(drive, outcomes)
@@ -387,6 +382,16 @@ def _write_and_verify(drive: Drive, writes: list[tuple[Variable, object]], kind:
         pending = mismatched
         if not pending:
             break
+
+
+def _wait_batch(batch: TransferBatch, cancel: Cancellation | None) -> list[object]:
+    """The outcomes of a batch; a cancellation meanwhile drops its transfers not yet sent."""
+    forget = cancel.on_cancel(batch.cancel) if cancel is not None else None
+    try:
+        return batch.future.result()
+    finally:
+        if forget is not None:
+            forget()
 
 
 def _partial(drive: Drive, outcomes: dict[int, ObjectOutcome], error: SdoError) -> BackupError:
@@ -514,7 +519,3 @@ class _Reporter:
             self.progress({"type": "progress", "operation": self.operation, "node": self.node, "file": self.file,
                            "done": self.done, "total": self.total})
 
-
-def _cancel(futures: Iterable[Future]) -> None:
-    for future in futures:
-        future.cancel()
