@@ -13,7 +13,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 from servostudio.drive.access import DEFAULT_WAIT, DriveAccessError
-from servostudio.drive.sdo import SdoAbortError, SdoError
+from servostudio.drive.sdo import SdoAbortError
 from servostudio.od import Variable
 from servostudio.services.projects.compare import CompareRow
 from servostudio.services.projects.errors import ParameterRefused
@@ -119,17 +119,14 @@ def write_to_drive(parameters: ParameterService, project: str, link: AxisLink, a
             drive.prepare_write(write.variable, write.value)
         except DriveAccessError as error:
             raise ParameterRefused(f"{error}; nothing was written") from None
-    futures = [(write, drive.submit_write(write.variable, write.value)) for write in writes]
-    for position, (write, future) in enumerate(futures):
-        try:
-            future.result(DEFAULT_WAIT)
+    batch = drive.submit_write_all([(write.variable, write.value) for write in writes])
+    for write, outcome in zip(writes, batch.future.result(DEFAULT_WAIT)):
+        if isinstance(outcome, SdoAbortError):
+            write.status, write.error = "failed", outcome.reason
+        elif isinstance(outcome, Exception):  # no answer: the first such write ended the batch
+            raise outcome
+        else:
             write.status = "written"
-        except SdoAbortError as error:
-            write.status, write.error = "failed", error.reason
-        except SdoError:
-            for _, later in futures[position + 1:]:
-                later.cancel()
-            raise
     report = DriveWriteReport(axis, writes)
     after = DriveValues(drive, [write.variable for write in writes])
     for write in writes:
