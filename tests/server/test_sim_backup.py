@@ -17,6 +17,7 @@ from servostudio.services.backup import (
 from servostudio.formats.objectfile import read_object_file
 from servostudio.services.bus import ConnectionManager
 from servostudio.services.scan import scan
+from servostudio.sim.nmt import NmtState
 
 
 @pytest.fixture(scope="module")
@@ -149,17 +150,18 @@ def test_a_drive_that_stops_answering_ends_the_restore_at_its_first_silent_write
     drive = connection.drive(3)
     path = tmp_path / "DRIVEPAR.TXT"
     backup_file(drive, path)
-    silent = threading.Event()
+    node = sim_network.node(3)
+    stop_posted = threading.Event()
     sent_while_silent = []
 
-    def spy_receive(self, frame, timestamp):
-        if silent.is_set() and frame.can_id in (0x603, 0x643) and frame.data[0] & 0xE0 == 0x20:
-            sent_while_silent.append(frame)  # a download request to node 3 (direct or redirected)
+    def spy_receive(self, frame, timestamp):  # on the simulation thread, with the frame's delivery to node 3
+        if node.state is NmtState.STOPPED and frame.can_id in (0x603, 0x643) and frame.data[0] & 0xE0 == 0x20:
+            sent_while_silent.append(frame)  # a download request (direct or redirected) node 3 will not answer
 
     def progress(event):
-        if event["done"] > 0 and not silent.is_set():
-            sim_network.post(lambda: sim_network.node(3).nmt_command(0x02))  # stop: no more SDO answers
-            silent.set()
+        if event["done"] > 0 and not stop_posted.is_set():
+            stop_posted.set()
+            sim_network.post(lambda: node.nmt_command(0x02))  # NMT stop: no more SDO answers
 
     station = type("Spy", (), {"receive": spy_receive})()
     sim_network.attach(station)
@@ -168,7 +170,7 @@ def test_a_drive_that_stops_answering_ends_the_restore_at_its_first_silent_write
             result = restore_file(drive, path, progress=progress)
     finally:
         sim_network.detach(station)
-        sim_network.post(lambda: sim_network.node(3).nmt_command(0x80))  # back to pre-operational
+        sim_network.post(lambda: node.nmt_command(0x80))  # back to pre-operational
     assert not result.ok and "no SDO response" in result.error
     assert "objects had been written; nothing was stored to flash" in result.error
     assert 1 <= len(sent_while_silent) <= 3, len(sent_while_silent)
