@@ -55,6 +55,25 @@ class _HoldAtFirstStep:
             self.released.wait(WAIT)
 
 
+def _cancel_at_first_step(app, client: TestClient, operation: str, url: str,
+                          body: dict) -> tuple[dict, dict, _HoldAtFirstStep]:
+    """Start a job, cancel it while its first progress step holds the bus reader, let it finish.
+    Answers (job as started, job as finished, the listener with the job events)."""
+    hub = app.state.connections.events
+    hold = _HoldAtFirstStep(operation)
+    hub.add_listener(hold)
+    try:
+        job = client.post(url, json=body).json()
+        assert hold.reached.wait(WAIT), f"the {operation} never reported progress"
+        answer = client.post(f"/api/jobs/{job['id']}/cancel")
+        assert answer.status_code == 200 and answer.json()["state"] == "running"
+        hold.released.set()
+        return job, _finish(client, job["id"]), hold
+    finally:
+        hold.released.set()
+        hub.remove_listener(hold)
+
+
 def _changed_file(app, client: TestClient, directory: Path) -> dict[tuple[int, int], tuple[int, int]]:
     """Back up node 1's DRIVEPAR.TXT, then rewrite it with every plain integer value raised by one.
     Answers {(index, sub): (value on the drive, value in the file)}."""
@@ -77,21 +96,8 @@ def _changed_file(app, client: TestClient, directory: Path) -> dict[tuple[int, i
 def test_cancelled_restore_reports_exactly_what_was_written(app_client, tmp_path):
     app, client = app_client
     changed = _changed_file(app, client, tmp_path)
-    hub = app.state.connections.events
-    hold = _HoldAtFirstStep("restore")
-    hub.add_listener(hold)
-    try:
-        job = client.post("/api/buses/sim/restore", json={"directory": str(tmp_path), "nodes": [1],
-                                                           "files": ["DRIVEPAR.TXT"], "store": False}).json()
-        assert hold.reached.wait(WAIT), "the restore never reported progress"
-        answer = client.post(f"/api/jobs/{job['id']}/cancel")
-        assert answer.status_code == 200 and answer.json()["state"] == "running"
-        hold.released.set()
-        finished = _finish(client, job["id"])
-    finally:
-        hold.released.set()
-        hub.remove_listener(hold)
-
+    job, finished, hold = _cancel_at_first_step(app, client, "restore", "/api/buses/sim/restore", {
+        "directory": str(tmp_path), "nodes": [1], "files": ["DRIVEPAR.TXT"], "store": False})
     assert finished["state"] == "cancelled"
     (result,) = finished["result"]["1"]
     assert result["cancelled"] is True and result["ok"] is False and result["stored"] == ""
@@ -111,18 +117,8 @@ def test_cancelled_restore_reports_exactly_what_was_written(app_client, tmp_path
 
 def test_cancelled_backup_leaves_no_file(app_client, tmp_path):
     app, client = app_client
-    hub = app.state.connections.events
-    hold = _HoldAtFirstStep("backup")
-    hub.add_listener(hold)
-    try:
-        job = client.post("/api/buses/sim/backup", json={"directory": str(tmp_path), "nodes": [1, 2]}).json()
-        assert hold.reached.wait(WAIT)
-        assert client.post(f"/api/jobs/{job['id']}/cancel").status_code == 200
-        hold.released.set()
-        finished = _finish(client, job["id"])
-    finally:
-        hold.released.set()
-        hub.remove_listener(hold)
+    _, finished, _ = _cancel_at_first_step(app, client, "backup", "/api/buses/sim/backup",
+                                           {"directory": str(tmp_path), "nodes": [1, 2]})
     assert finished["state"] == "cancelled"
     assert finished["result"] == {"1": [], "2": []}  # no file was complete when the cancel came
     assert [path for path in tmp_path.rglob("*") if path.is_file()] == []
