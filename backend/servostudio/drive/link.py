@@ -141,16 +141,16 @@ class BusLink:
         (``receive_frames``), else one python-can message."""
         receive_frames = getattr(bus, "receive_frames", None)
         if receive_frames is not None:
-            frames = [(cob_id, data, timestamp) for cob_id, data, timestamp, _ in receive_frames(POLL_INTERVAL)]
+            frames = receive_frames(POLL_INTERVAL)
         else:
             message = bus.recv(POLL_INTERVAL)
             frames = [] if message is None or message.is_error_frame or message.is_remote_frame else [
-                (message.arbitration_id, bytes(message.data), message.timestamp)]
+                (message.arbitration_id, bytes(message.data), message.timestamp, message.is_extended_id)]
         if not frames:
             return
         self._held = []
         try:
-            for cob_id, data, timestamp in frames:
+            for cob_id, data, timestamp, _extended in frames:
                 self._dispatch(cob_id, data, timestamp or time.time())
         finally:
             held, self._held = self._held, None
