@@ -111,8 +111,11 @@ def steal_share(before: list[int] | None, after: list[int] | None) -> str:
 def serve_simulation(drives: int, port: int) -> None:
     """The simulator process: idle drives on the timed bus, run in real time by the product's own loop
     (`SimulatedNetwork.start()`, as in `servostudio sim`), behind socketcand."""
-    network = SimulatedNetwork(",".join(str(node) for node in range(1, drives + 1)),
-                               behaviour_factory=lambda *args: IdleBehaviour(), bitrate=BITRATE)
+    network = SimulatedNetwork(
+        ",".join(str(node) for node in range(1, drives + 1)),
+        behaviour_factory=lambda *args: IdleBehaviour(),
+        bitrate=BITRATE,
+    )
     network.start()
     server = SocketcandServer(network, port=port).start()
     print(server.address[1], flush=True)
@@ -121,13 +124,23 @@ def serve_simulation(drives: int, port: int) -> None:
 
 class Bench:
     def __init__(self, drives: int) -> None:
-        self.process = subprocess.Popen([sys.executable, __file__, "--serve-simulation", str(drives)],
-                                        stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True)
+        self.process = subprocess.Popen(
+            [sys.executable, __file__, "--serve-simulation", str(drives)],
+            stdin=subprocess.PIPE,
+            stdout=subprocess.PIPE,
+            text=True,
+        )
         self.port = int(self.process.stdout.readline())
         self.link = BusLink("bench", self.open_bus)
         self.link.start(wait=5.0)
-        self.connection = BusConnection("bench", parse_bus_spec(f"socketcand:127.0.0.1:{self.port}"), self.link,
-                                        SdoEngine(self.link, 1.0), builtin_library(), EventHub())
+        self.connection = BusConnection(
+            "bench",
+            parse_bus_spec(f"socketcand:127.0.0.1:{self.port}"),
+            self.link,
+            SdoEngine(self.link, 1.0),
+            builtin_library(),
+            EventHub(),
+        )
         scan(self.connection)
 
     def open_bus(self) -> SocketcandBus:
@@ -155,8 +168,15 @@ def measure_reads(bench: Bench, count: int, nodes: list[int], repeats: int) -> d
     wall, cpu, values = sorted(runs, key=lambda run: run[0])[len(runs) // 2]
     limit = bound({node: [(0x6041, 0, values[0])] * count for node in nodes})
     total = count * len(nodes)
-    return {"reads": total, "wall": wall, "best": min(run[0] for run in runs), "cpu_us": cpu / total * 1e6,
-            "bound": limit, "rate": total / wall, "bound_rate": total / limit}
+    return {
+        "reads": total,
+        "wall": wall,
+        "best": min(run[0] for run in runs),
+        "cpu_us": cpu / total * 1e6,
+        "bound": limit,
+        "rate": total / wall,
+        "bound_rate": total / limit,
+    }
 
 
 def backup_objects_of(bench: Bench, node: int) -> list[tuple[int, int, bytes]]:
@@ -178,8 +198,9 @@ def measure_backup(bench: Bench, nodes: list[int], folder: Path, repeats: int) -
     sizes = {node: backup_objects_of(bench, node) for node in nodes}
 
     def ours():
-        results = run_per_drive(drives, lambda drive: backup_file(drive, folder / f"node{drive.node}_DRIVEPAR.TXT",
-                                                                 FileKind.DRIVEPAR))
+        results = run_per_drive(
+            drives, lambda drive: backup_file(drive, folder / f"node{drive.node}_DRIVEPAR.TXT", FileKind.DRIVEPAR)
+        )
         for result in results.values():
             if isinstance(result, Exception):
                 raise result
@@ -188,8 +209,15 @@ def measure_backup(bench: Bench, nodes: list[int], folder: Path, repeats: int) -
     wall, cpu, _ = sorted(runs, key=lambda run: run[0])[len(runs) // 2]
     naive_wall, naive_cpu, _ = bench.timed(lambda: naive_backup(bench, sizes))
     objects = sum(len(objects) for objects in sizes.values())
-    return {"objects": objects, "wall": wall, "best": min(run[0] for run in runs), "cpu_us": cpu / objects * 1e6,
-            "naive_wall": naive_wall, "naive_cpu_us": naive_cpu / objects * 1e6, "bound": bound(sizes)}
+    return {
+        "objects": objects,
+        "wall": wall,
+        "best": min(run[0] for run in runs),
+        "cpu_us": cpu / objects * 1e6,
+        "naive_wall": naive_wall,
+        "naive_cpu_us": naive_cpu / objects * 1e6,
+        "bound": bound(sizes),
+    }
 
 
 def naive_backup(bench: Bench, sizes: dict[int, list[tuple[int, int, bytes]]]) -> None:
@@ -221,26 +249,34 @@ def main() -> int:
     nodes = list(range(1, args.drives + 1))
     counters = cpu_times()
     try:
-        print(f"# {time.strftime('%Y-%m-%d %H:%M')} UTC, load average {os.getloadavg()[0]:.1f}, "
-              f"{len(bench.connection.nodes)} simulated drives, 1 Mbit/s, 1 ms SDO response time, "
-              f"median of {args.repeats} runs (best in brackets)")
+        print(
+            f"# {time.strftime('%Y-%m-%d %H:%M')} UTC, load average {os.getloadavg()[0]:.1f}, "
+            f"{len(bench.connection.nodes)} simulated drives, 1 Mbit/s, 1 ms SDO response time, "
+            f"median of {args.repeats} runs (best in brackets)"
+        )
         print("\n| SDO reads (0x6041) | reads | wall s | reads/s | bound reads/s | wall / bound | client CPU µs/read |")
         print("|---|---|---|---|---|---|---|")
         for label, chosen in (("1 drive", nodes[:1]), (f"{len(nodes)} drives", nodes)):
             result = measure_reads(bench, args.reads, chosen, args.repeats)
-            print(f"| {label} | {result['reads']} | {result['wall']:.3f} | {result['rate']:.0f} | "
-                  f"{result['bound_rate']:.0f} | {result['wall'] / result['bound']:.2f} "
-                  f"({result['best'] / result['bound']:.2f}) | {result['cpu_us']:.0f} |")
-        print("\n| DRIVEPAR.TXT backup | objects | bound s | ours s | ours / bound | naive canopen s | naive / ours | "
-              "client CPU µs/object ours / naive |")
+            print(
+                f"| {label} | {result['reads']} | {result['wall']:.3f} | {result['rate']:.0f} | "
+                f"{result['bound_rate']:.0f} | {result['wall'] / result['bound']:.2f} "
+                f"({result['best'] / result['bound']:.2f}) | {result['cpu_us']:.0f} |"
+            )
+        print(
+            "\n| DRIVEPAR.TXT backup | objects | bound s | ours s | ours / bound | naive canopen s | naive / ours | "
+            "client CPU µs/object ours / naive |"
+        )
         print("|---|---|---|---|---|---|---|---|")
         with tempfile.TemporaryDirectory() as folder:
             for label, chosen in (("1 drive", nodes[:1]), (f"{len(nodes)} drives", nodes)):
                 result = measure_backup(bench, chosen, Path(folder), args.repeats)
-                print(f"| {label} | {result['objects']} | {result['bound']:.3f} | {result['wall']:.3f} | "
-                      f"{result['wall'] / result['bound']:.2f} ({result['best'] / result['bound']:.2f}) | "
-                      f"{result['naive_wall']:.3f} | {result['naive_wall'] / result['wall']:.1f} | "
-                      f"{result['cpu_us']:.0f} / {result['naive_cpu_us']:.0f} |")
+                print(
+                    f"| {label} | {result['objects']} | {result['bound']:.3f} | {result['wall']:.3f} | "
+                    f"{result['wall'] / result['bound']:.2f} ({result['best'] / result['bound']:.2f}) | "
+                    f"{result['naive_wall']:.3f} | {result['naive_wall'] / result['wall']:.1f} | "
+                    f"{result['cpu_us']:.0f} / {result['naive_cpu_us']:.0f} |"
+                )
         print(f"\nCPU time taken by the hypervisor during the run (steal): {steal_share(counters, cpu_times())}")
     finally:
         bench.close()

@@ -56,8 +56,9 @@ def enable(store: ObjectStore, control_word: int) -> None:
     store.write_from_bus(0x6040, 0, control_word)
 
 
-def measure(axes: int, seconds: float, build: Callable[[int], tuple[list[ObjectStore], Callable[[float], None]]]
-            ) -> tuple[float, float]:
+def measure(
+    axes: int, seconds: float, build: Callable[[int], tuple[list[ObjectStore], Callable[[float], None]]]
+) -> tuple[float, float]:
     stores, advance = build(axes)
     for store in stores:
         start_motion(store)
@@ -116,18 +117,26 @@ def main() -> None:
     parser.add_argument("--seconds", type=float, default=2.0, help="simulated seconds per measurement")
     args = parser.parse_args()
     load = os.getloadavg()[0] if hasattr(os, "getloadavg") else float("nan")
-    print(f"control period {CONTROL_PERIOD * 1e6:.0f} µs, {args.seconds:g} s simulated, load average {load:.1f}, "
-          f"{os.cpu_count()} CPUs, Python call {call_cost_ns():.0f} ns")
-    print(f"| {'level':<13} | axes | wall s | CPU s | real-time factor (wall) | real-time factor (CPU) "
-          f"| µs CPU per axis-period |")
-    print(f"|{'-' * 15}|------|--------|-------|-------------------------|------------------------"
-          f"|------------------------|")
+    print(
+        f"control period {CONTROL_PERIOD * 1e6:.0f} µs, {args.seconds:g} s simulated, load average {load:.1f}, "
+        f"{os.cpu_count()} CPUs, Python call {call_cost_ns():.0f} ns"
+    )
+    print(
+        f"| {'level':<13} | axes | wall s | CPU s | real-time factor (wall) | real-time factor (CPU) "
+        f"| µs CPU per axis-period |"
+    )
+    print(
+        f"|{'-' * 15}|------|--------|-------|-------------------------|------------------------"
+        f"|------------------------|"
+    )
     for name, build in (("drive engine", engine), ("network", network)):
         for axes in (1, 8):
             wall, cpu = measure(axes, args.seconds, build)
             per_period = cpu / (args.seconds / CONTROL_PERIOD) / axes * 1e6
-            print(f"| {name:<13} | {axes:>4} | {wall:6.2f} | {cpu:5.2f} | {args.seconds / wall:23.2f} "
-                  f"| {args.seconds / cpu:22.2f} | {per_period:22.1f} |")
+            print(
+                f"| {name:<13} | {axes:>4} | {wall:6.2f} | {cpu:5.2f} | {args.seconds / wall:23.2f} "
+                f"| {args.seconds / cpu:22.2f} | {per_period:22.1f} |"
+            )
 
 
 if __name__ == "__main__":

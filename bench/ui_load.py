@@ -27,45 +27,134 @@ from playwright.sync_api import sync_playwright
 REPO = Path(__file__).resolve().parent.parent
 OBJECTS = 1000
 RUNS = 5
-GROUPS = ["General", "Motor", "Sensors", "Servo Loops", "Position Control", "Inputs/Outputs", "Homing Mode",
-          "Profile Position Mode", "Error Control", "Factor"]
-CHROMIUM_ARGS = ["--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
-                 "--disable-background-networking", "--disable-component-update", "--disable-sync"]
+GROUPS = [
+    "General",
+    "Motor",
+    "Sensors",
+    "Servo Loops",
+    "Position Control",
+    "Inputs/Outputs",
+    "Homing Mode",
+    "Profile Position Mode",
+    "Error Control",
+    "Factor",
+]
+CHROMIUM_ARGS = [
+    "--no-sandbox",
+    "--disable-gpu",
+    "--disable-quic",
+    "--no-first-run",
+    "--disable-background-networking",
+    "--disable-component-update",
+    "--disable-sync",
+]
 
 
 def synthetic_eds(directory: Path) -> tuple[Path, Path]:
     """A valid CiA 306 EDS with OBJECTS manufacturer objects (0x2000…) and its companion .props."""
     indices = [0x2000 + i for i in range(OBJECTS)]
     eds = [
-        "[FileInfo]", "FileName=bench1000.eds", "FileVersion=1", "FileRevision=0", "EDSVersion=4.0",
-        "Description=Synthetic 1000-object dictionary for the UI benchmark", "CreatedBy=Servo Studio bench", "",
-        "[DeviceInfo]", "VendorName=Bench", "VendorNumber=0x00BE0C00", "ProductName=Bench 1000",
-        "ProductNumber=0x00001000", "RevisionNumber=0x00000001", "BaudRate_1000=1", "SimpleBootUpSlave=1",
-        "Granularity=8", "NrOfRxPDO=0", "NrOfTxPDO=0", "LSS_Supported=0", "",
-        "[MandatoryObjects]", "SupportedObjects=3", "1=0x1000", "2=0x1001", "3=0x1018", "",
-        "[1000]", "ParameterName=Device type", "ObjectType=0x7", "DataType=0x0007", "AccessType=ro",
-        "DefaultValue=0x00020192", "PDOMapping=0", "",
-        "[1001]", "ParameterName=Error register", "ObjectType=0x7", "DataType=0x0005", "AccessType=ro",
-        "DefaultValue=0", "PDOMapping=1", "",
-        "[1018]", "ParameterName=Identity object", "ObjectType=0x9", "SubNumber=3", "",
-        "[1018sub0]", "ParameterName=Number of entries", "ObjectType=0x7", "DataType=0x0005", "AccessType=ro",
-        "DefaultValue=2", "PDOMapping=0", "",
-        "[1018sub1]", "ParameterName=Vendor-ID", "ObjectType=0x7", "DataType=0x0007", "AccessType=ro",
-        "DefaultValue=0x00BE0C00", "PDOMapping=0", "",
-        "[1018sub2]", "ParameterName=Product code", "ObjectType=0x7", "DataType=0x0007", "AccessType=ro",
-        "DefaultValue=0x00001000", "PDOMapping=0", "",
-        "[OptionalObjects]", "SupportedObjects=0", "",
-        "[ManufacturerObjects]", f"SupportedObjects={OBJECTS}",
-        *[f"{n}=0x{index:04X}" for n, index in enumerate(indices, start=1)], "",
+        "[FileInfo]",
+        "FileName=bench1000.eds",
+        "FileVersion=1",
+        "FileRevision=0",
+        "EDSVersion=4.0",
+        "Description=Synthetic 1000-object dictionary for the UI benchmark",
+        "CreatedBy=Servo Studio bench",
+        "",
+        "[DeviceInfo]",
+        "VendorName=Bench",
+        "VendorNumber=0x00BE0C00",
+        "ProductName=Bench 1000",
+        "ProductNumber=0x00001000",
+        "RevisionNumber=0x00000001",
+        "BaudRate_1000=1",
+        "SimpleBootUpSlave=1",
+        "Granularity=8",
+        "NrOfRxPDO=0",
+        "NrOfTxPDO=0",
+        "LSS_Supported=0",
+        "",
+        "[MandatoryObjects]",
+        "SupportedObjects=3",
+        "1=0x1000",
+        "2=0x1001",
+        "3=0x1018",
+        "",
+        "[1000]",
+        "ParameterName=Device type",
+        "ObjectType=0x7",
+        "DataType=0x0007",
+        "AccessType=ro",
+        "DefaultValue=0x00020192",
+        "PDOMapping=0",
+        "",
+        "[1001]",
+        "ParameterName=Error register",
+        "ObjectType=0x7",
+        "DataType=0x0005",
+        "AccessType=ro",
+        "DefaultValue=0",
+        "PDOMapping=1",
+        "",
+        "[1018]",
+        "ParameterName=Identity object",
+        "ObjectType=0x9",
+        "SubNumber=3",
+        "",
+        "[1018sub0]",
+        "ParameterName=Number of entries",
+        "ObjectType=0x7",
+        "DataType=0x0005",
+        "AccessType=ro",
+        "DefaultValue=2",
+        "PDOMapping=0",
+        "",
+        "[1018sub1]",
+        "ParameterName=Vendor-ID",
+        "ObjectType=0x7",
+        "DataType=0x0007",
+        "AccessType=ro",
+        "DefaultValue=0x00BE0C00",
+        "PDOMapping=0",
+        "",
+        "[1018sub2]",
+        "ParameterName=Product code",
+        "ObjectType=0x7",
+        "DataType=0x0007",
+        "AccessType=ro",
+        "DefaultValue=0x00001000",
+        "PDOMapping=0",
+        "",
+        "[OptionalObjects]",
+        "SupportedObjects=0",
+        "",
+        "[ManufacturerObjects]",
+        f"SupportedObjects={OBJECTS}",
+        *[f"{n}=0x{index:04X}" for n, index in enumerate(indices, start=1)],
+        "",
     ]
     props = ["; properties of the synthetic benchmark dictionary", ""]
     for n, index in enumerate(indices):
-        eds += [f"[{index:04X}]", f"ParameterName=Parameter {n} gain {n % 13}", "ObjectType=0x7",
-                f"DataType={'0x0006' if n % 2 else '0x0004'}", "AccessType=rw", f"DefaultValue={n % 100}",
-                "PDOMapping=0", "LowLimit=0", "HighLimit=30000", ""]
-        props += [f"[{index:04X}]", f"Group={GROUPS[n % len(GROUPS)]}",
-                  f"Description=Synthetic parameter {n}: loop gain {n % 13}, filter {n % 7}",
-                  f"Unit={'rpm' if n % 3 == 0 else 'A'}", ""]
+        eds += [
+            f"[{index:04X}]",
+            f"ParameterName=Parameter {n} gain {n % 13}",
+            "ObjectType=0x7",
+            f"DataType={'0x0006' if n % 2 else '0x0004'}",
+            "AccessType=rw",
+            f"DefaultValue={n % 100}",
+            "PDOMapping=0",
+            "LowLimit=0",
+            "HighLimit=30000",
+            "",
+        ]
+        props += [
+            f"[{index:04X}]",
+            f"Group={GROUPS[n % len(GROUPS)]}",
+            f"Description=Synthetic parameter {n}: loop gain {n % 13}, filter {n % 7}",
+            f"Unit={'rpm' if n % 3 == 0 else 'A'}",
+            "",
+        ]
     eds_path, props_path = directory / "bench1000.eds", directory / "bench1000.props"
     eds_path.write_text("\n".join(eds), encoding="latin-1")
     props_path.write_text("\n".join(props), encoding="latin-1")
@@ -83,8 +172,13 @@ def start_server(scratch: Path) -> tuple[subprocess.Popen, str]:
     shutil.copytree(REPO / "projects" / "demo", projects / "demo")
     port = free_port()
     env = {**os.environ, "SERVOSTUDIO_USER_EDS_DIR": str(scratch / "user-eds"), "PYTHONUNBUFFERED": "1"}
-    process = subprocess.Popen([sys.executable, "-m", "servostudio", "serve", "--port", str(port), "--projects",
-                                str(projects)], cwd=REPO, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    process = subprocess.Popen(
+        [sys.executable, "-m", "servostudio", "serve", "--port", str(port), "--projects", str(projects)],
+        cwd=REPO,
+        env=env,
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.DEVNULL,
+    )
     url = f"http://127.0.0.1:{port}"
     deadline = time.monotonic() + 60
     while time.monotonic() < deadline:
@@ -128,8 +222,11 @@ def main() -> None:
         try:
             eds, props = synthetic_eds(scratch)
             with eds.open("rb") as eds_file, props.open("rb") as props_file:
-                answer = httpx.post(url + "/api/dictionaries", timeout=120,
-                                    files={"eds": (eds.name, eds_file), "props": (props.name, props_file)})
+                answer = httpx.post(
+                    url + "/api/dictionaries",
+                    timeout=120,
+                    files={"eds": (eds.name, eds_file), "props": (props.name, props_file)},
+                )
             answer.raise_for_status()
             device = answer.json()["device"]
             dictionary = httpx.get(f"{url}/api/dictionaries/{device}", timeout=60).json()
@@ -140,10 +237,14 @@ def main() -> None:
             process.wait(timeout=10)
     print(f"main page interactive (tree and server state shown): median {results['main']:.0f} ms")
     print(f"main page DOMContentLoaded: median {results['dcl']:.0f} ms")
-    print(f"{len(dictionary['objects'])}-object dictionary ({entries} entries) shown in the editor: median {results['render']:.0f} ms "
-          f"(of which fetching the dictionary: {results['fetch']:.0f} ms)")
-    print(f"filter {entries} entries on a keystroke (incl. 60 ms debounce): median {results['filter']:.0f} ms "
-          f"(\"{results['label']}\")")
+    print(
+        f"{len(dictionary['objects'])}-object dictionary ({entries} entries) shown in the editor: median {results['render']:.0f} ms "
+        f"(of which fetching the dictionary: {results['fetch']:.0f} ms)"
+    )
+    print(
+        f"filter {entries} entries on a keystroke (incl. 60 ms debounce): median {results['filter']:.0f} ms "
+        f'("{results["label"]}")'
+    )
 
 
 def measure(chromium: str, url: str, device: str) -> dict[str, float | str]:
@@ -165,16 +266,24 @@ def measure(chromium: str, url: str, device: str) -> dict[str, float | str]:
             page.goto(f"{url}/dictionaries/{device}")
             page.wait_for_selector(".prow.entry")
             render_times.append((time.perf_counter() - start) * 1000)
-            fetch_times.append(page.evaluate(
-                f"performance.getEntriesByName(location.origin + '/api/dictionaries/{device}')[0].duration"))
+            fetch_times.append(
+                page.evaluate(
+                    f"performance.getEntriesByName(location.origin + '/api/dictionaries/{device}')[0].duration"
+                )
+            )
             for text in ("gain 3", "filter 5", "0x2100", "Parameter 999"):
                 elapsed, label = page.evaluate(FILTER_SCRIPT, text)
                 filter_times.append(elapsed)
             context.close()
         browser.close()
-    return {"main": statistics.median(main_times), "dcl": statistics.median(dcl_times),
-            "render": statistics.median(render_times), "fetch": statistics.median(fetch_times),
-            "filter": statistics.median(filter_times), "label": label}
+    return {
+        "main": statistics.median(main_times),
+        "dcl": statistics.median(dcl_times),
+        "render": statistics.median(render_times),
+        "fetch": statistics.median(fetch_times),
+        "filter": statistics.median(filter_times),
+        "label": label,
+    }
 
 
 if __name__ == "__main__":

@@ -27,12 +27,26 @@ class LiveServer:
     def __init__(self, projects_dir: Path, extra_args: list[str] | None = None) -> None:
         self.port = free_port()
         self.url = f"http://127.0.0.1:{self.port}"
-        command = [sys.executable, "-m", "servostudio", "serve", "--port", str(self.port),
-                   "--projects", str(projects_dir), *(extra_args or [])]
+        command = [
+            sys.executable,
+            "-m",
+            "servostudio",
+            "serve",
+            "--port",
+            str(self.port),
+            "--projects",
+            str(projects_dir),
+            *(extra_args or []),
+        ]
         self.log = projects_dir.parent / f"server-{self.port}.log"
         self._log_file = self.log.open("wb")
-        self.process = subprocess.Popen(command, cwd=REPO_ROOT, stdout=self._log_file, stderr=subprocess.STDOUT,
-                                        env={**os.environ, "PYTHONUNBUFFERED": "1"})
+        self.process = subprocess.Popen(
+            command,
+            cwd=REPO_ROOT,
+            stdout=self._log_file,
+            stderr=subprocess.STDOUT,
+            env={**os.environ, "PYTHONUNBUFFERED": "1"},
+        )
 
     def wait_ready(self, timeout: float = 30.0) -> None:
         deadline = time.monotonic() + timeout

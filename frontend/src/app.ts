@@ -3,16 +3,16 @@
  * keyboard shortcuts and theme. Pages are plain modules that build their element from a `PageContext`.
  */
 
-import { getHealth, getMe, projects, type Project } from "./api";
+import { getHealth, getMe, projects, type Project } from "./client/api";
 import { errorText } from "./components/ui";
 import { h, replaceChildren } from "./lib/dom";
 import { BINDINGS, KeyMatcher } from "./lib/keys";
 import { buildPath, parsePath, samePage, type AxisView, type Location, type Route } from "./lib/router";
-import { LiveHub, axisStateText } from "./live";
+import { LiveHub, axisStateText } from "./client/live";
 import { showHelp, toggleHelp } from "./components/help";
 import { applyTheme, storedTheme, toggleTheme } from "./components/theme";
 import { mountPage } from "./pages";
-import { driveApi, learnBuses } from "./drives";
+import { driveApi, learnBuses } from "./client/drives";
 
 /** Tree states come from events (`drive_state`, NMT, EMCY); only while the event socket is down are they polled. */
 const TREE_FALLBACK_MS = 10000;

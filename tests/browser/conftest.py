@@ -14,7 +14,6 @@ from pathlib import Path
 import httpx
 import pytest
 from playwright.sync_api import Browser, Page, expect, sync_playwright
-
 from tests.conftest import REPO_ROOT, LiveServer
 
 # The test machine is shared and slow at times: allow pages more than Playwright's default 5 s to settle.
@@ -99,10 +98,12 @@ def demo_server(tmp_path_factory: pytest.TempPathFactory):
         # The UI maps a project bus to the server's bus of the same name, else of the same spec; so does the test.
         open_buses = httpx.get(f"{server.url}/api/buses", timeout=15.0).json()
         match = next((b for b in open_buses if b["id"] == bus["name"]), None) or next(
-            (b for b in open_buses if b["spec"] == bus["interface"]), None)
+            (b for b in open_buses if b["spec"] == bus["interface"]), None
+        )
         if match is None:
-            match = httpx.post(f"{server.url}/api/buses", json={"spec": bus["interface"], "id": bus["name"]},
-                               timeout=30.0).json()
+            match = httpx.post(
+                f"{server.url}/api/buses", json={"spec": bus["interface"], "id": bus["name"]}, timeout=30.0
+            ).json()
         yield DemoServer(server.url, "demo", match["id"], tuple((a["name"], a["node_id"]) for a in project["axes"]))
     finally:
         server.stop()

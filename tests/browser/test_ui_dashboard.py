@@ -55,7 +55,6 @@ def test_live_values_and_enabling_the_axis_step_by_step(page: Page, demo_server:
     assert drive_state(demo_server, node) == "SWITCH ON DISABLED"
 
 
-
 def test_closing_the_page_stops_the_axis_it_enabled(browser, demo_server: DemoServer) -> None:
     """Motion needs a live client: when the page that enabled an axis goes away, the server quick-stops it."""
     axis, node = demo_server.axes[2]
@@ -67,8 +66,11 @@ def test_closing_the_page_stops_the_axis_it_enabled(browser, demo_server: DemoSe
     if state.inner_text() != "Switch on disabled":
         page.get_by_test_id("transition-disable_voltage").click()
     expect(state).to_have_text("Switch on disabled")
-    for transition, shown in (("shutdown", "Ready to switch on"), ("switch_on", "Switched on"),
-                              ("enable_operation", "Operation enabled")):
+    for transition, shown in (
+        ("shutdown", "Ready to switch on"),
+        ("switch_on", "Switched on"),
+        ("enable_operation", "Operation enabled"),
+    ):
         page.get_by_test_id(f"transition-{transition}").click()
         expect(state).to_have_text(shown)
     assert drive_state(demo_server, node) == "OPERATION ENABLED"

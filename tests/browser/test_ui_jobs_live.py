@@ -12,8 +12,9 @@ ATTEMPTS = 3
 def test_cancel_a_file_restore_job(page: Page, demo_server: DemoServer, tmp_path) -> None:
     axis, node = demo_server.axes[0]
     drivepar = tmp_path / "DRIVEPAR.TXT"
-    drivepar.write_bytes(demo_server.api("GET", f"/api/buses/{demo_server.bus}/nodes/{node}/files/DRIVEPAR.TXT")
-                         .content)
+    drivepar.write_bytes(
+        demo_server.api("GET", f"/api/buses/{demo_server.bus}/nodes/{node}/files/DRIVEPAR.TXT").content
+    )
     page.goto(f"{demo_server.url}/projects/{demo_server.project}/axes/{axis}/backup")
     result = page.get_by_test_id("backup-result")
     # The job may end before the click reaches the server; then it reports a full restore, and we try again.
@@ -27,9 +28,12 @@ def test_cancel_a_file_restore_job(page: Page, demo_server: DemoServer, tmp_path
         if "cancelled" in result.inner_text():
             break
         expect(result).to_contain_text("verified")
-    expect(result).to_have_text(re.compile(
-        rf"Restoring DRIVEPAR\.TXT cancelled\. restore of node {node} cancelled: \d+ of \d+ objects were written"
-        r".*nothing was stored to flash \(.*not written.*\)"))
+    expect(result).to_have_text(
+        re.compile(
+            rf"Restoring DRIVEPAR\.TXT cancelled\. restore of node {node} cancelled: \d+ of \d+ objects were written"
+            r".*nothing was stored to flash \(.*not written.*\)"
+        )
+    )
     jobs = demo_server.api("GET", "/api/jobs").json()
     assert jobs[-1]["operation"] == "restore" and jobs[-1]["state"] == "cancelled"
     assert jobs[-1]["result"][str(node)][0]["stored"] == ""

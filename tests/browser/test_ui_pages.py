@@ -27,7 +27,9 @@ def test_new_project_from_a_bus_scan(page: Page, demo_server: DemoServer) -> Non
     expect(page.get_by_test_id("project-title")).to_have_text("line2")
     expect(page.get_by_test_id("axes-table")).to_contain_text(f"xtrapulspac-{node}")
     project = demo_server.api("GET", "/api/projects/line2").json()
-    assert [(a["name"], a["node_id"], a["device"]) for a in project["axes"]] == [(f"xtrapulspac-{node}", node, "xtrapulspac")]
+    assert [(a["name"], a["node_id"], a["device"]) for a in project["axes"]] == [
+        (f"xtrapulspac-{node}", node, "xtrapulspac")
+    ]
     expect(page.get_by_test_id(f"tree-state-xtrapulspac-{node}")).not_to_have_text("offline")
     page.get_by_test_id("commission-check").click()
     expect(page.get_by_test_id("commission-result")).to_have_text("check: every axis OK")

@@ -17,7 +17,9 @@ def test_kpv_found_changed_on_the_drive_and_persisted(page: Page, demo_server: D
     expect(row).to_be_visible()
     expect(page.get_by_test_id("param-count")).to_have_text("1 of 882 entries")
     row.click()
-    before = demo_server.api("GET", f"/api/buses/{demo_server.bus}/nodes/{node}/objects/0x60F9,2?device=xtrapulspac").json()["raw"]
+    before = demo_server.api(
+        "GET", f"/api/buses/{demo_server.bus}/nodes/{node}/objects/0x60F9,2?device=xtrapulspac"
+    ).json()["raw"]
     expect(page.get_by_test_id("detail-drive-value")).to_have_text(str(before))
     new_value = before + 111 if before < 60000 else before - 111
     editor = page.get_by_test_id("param-editor")
@@ -26,7 +28,9 @@ def test_kpv_found_changed_on_the_drive_and_persisted(page: Page, demo_server: D
     expect(page.get_by_test_id("detail-drive-value")).to_have_text(str(new_value))
     screenshot(page, "parameters-kpv-written")
 
-    on_drive = demo_server.api("GET", f"/api/buses/{demo_server.bus}/nodes/{node}/objects/0x60F9,2?device=xtrapulspac").json()
+    on_drive = demo_server.api(
+        "GET", f"/api/buses/{demo_server.bus}/nodes/{node}/objects/0x60F9,2?device=xtrapulspac"
+    ).json()
     assert on_drive["raw"] == new_value
     in_project = demo_server.api("GET", f"/api/projects/demo/axes/{axis}/parameters/0x60F9,2").json()
     assert in_project["value"] == new_value and in_project["file"] == "DRIVEPAR.TXT"
@@ -50,10 +54,11 @@ def test_decimal_point_in_a_german_browser_and_the_server_range_check(page: Page
     editor.fill("2.5")
     editor.press("Enter")
     expect(page.get_by_test_id("detail-drive-value")).to_have_text("2.5 A  (raw 2500)")
-    raw = demo_server.api("GET", f"/api/buses/{demo_server.bus}/nodes/{node}/objects/0x6075,0?device=xtrapulspac").json()["raw"]
+    raw = demo_server.api(
+        "GET", f"/api/buses/{demo_server.bus}/nodes/{node}/objects/0x6075,0?device=xtrapulspac"
+    ).json()["raw"]
     assert raw == 2500
     screenshot(page, "parameters-scaled-value")
-
 
 
 def test_only_differences_then_write_changed_to_the_drive(page: Page, demo_server: DemoServer) -> None:
@@ -77,8 +82,9 @@ def test_only_differences_then_write_changed_to_the_drive(page: Page, demo_serve
 def test_application_template_limits_the_editor_to_its_groups(page: Page, demo_server: DemoServer) -> None:
     """Device Config (manual §1.8.1): after choosing a template the editor opens on that application's groups."""
     demo_server.api("POST", "/api/projects", json={"name": "templated", "buses": [{"name": "sim", "interface": "sim"}]})
-    demo_server.api("POST", "/api/projects/templated/axes",
-                    json={"name": "A", "device": "xtrapulspac", "node_id": 1, "bus": "sim"})
+    demo_server.api(
+        "POST", "/api/projects/templated/axes", json={"name": "A", "device": "xtrapulspac", "node_id": 1, "bus": "sim"}
+    )
     chosen = demo_server.api("POST", "/api/projects/templated/axes/A/application", json={"template": "analog-speed"})
     template = demo_server.api("GET", "/api/projects/templated/axes/A/application").json()
     assert chosen.is_success and template["groups"]

@@ -66,7 +66,12 @@ def test_import_an_eds_and_browse_it(page: Page, demo_server: DemoServer, tmp_pa
     """A user EDS goes through the real import route; a broken one is refused with the loader's file:line reason."""
     source = Path(__file__).resolve().parents[2] / "eds"
     eds = tmp_path / "mydrive.eds"
-    eds.write_text((source / "encotrive.eds").read_text(encoding="latin-1").replace("ProductName=encoTRive MD-025", "ProductName=My drive"), encoding="latin-1")
+    eds.write_text(
+        (source / "encotrive.eds")
+        .read_text(encoding="latin-1")
+        .replace("ProductName=encoTRive MD-025", "ProductName=My drive"),
+        encoding="latin-1",
+    )
     page.goto(f"{demo_server.url}/dictionaries")
     page.get_by_test_id("import-eds").click()
     page.get_by_test_id("import-eds-file").set_input_files(str(eds))
@@ -79,7 +84,9 @@ def test_import_an_eds_and_browse_it(page: Page, demo_server: DemoServer, tmp_pa
     expect(page.get_by_test_id("param-count")).to_contain_text(" entries")
 
     broken = tmp_path / "broken.eds"
-    broken.write_text("[FileInfo]\nFileName=broken.eds\n[1000]\nParameterName=Device type\nObjectType=0x7\n", encoding="latin-1")
+    broken.write_text(
+        "[FileInfo]\nFileName=broken.eds\n[1000]\nParameterName=Device type\nObjectType=0x7\n", encoding="latin-1"
+    )
     page.goto(f"{demo_server.url}/dictionaries")
     page.get_by_test_id("import-eds").click()
     page.get_by_test_id("import-eds-file").set_input_files(str(broken))

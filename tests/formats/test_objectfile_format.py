@@ -30,8 +30,9 @@ def test_manual_examples_hex_and_decimal_mean_the_same_assignment() -> None:
 
 def test_manual_examples_together_are_a_duplicate(tmp_path: Path) -> None:
     both = tmp_path / "DRIVEPAR.TXT"
-    both.write_text((FIXTURES / "manual_objectfile_hex.txt").read_text()
-                    + (FIXTURES / "manual_objectfile_decimal.txt").read_text())
+    both.write_text(
+        (FIXTURES / "manual_objectfile_hex.txt").read_text() + (FIXTURES / "manual_objectfile_decimal.txt").read_text()
+    )
     with pytest.raises(ObjectFileError) as caught:
         read_object_file(both)
     assert (caught.value.file, caught.value.line) == (str(both), 2)
@@ -41,14 +42,16 @@ def test_manual_examples_together_are_a_duplicate(tmp_path: Path) -> None:
 
 
 def test_comments_and_lines_not_starting_with_a_digit_are_ignored() -> None:
-    text = ("; saved by the drive\n"
-            "0x6060,0=-3 ; trailing comment\n"
-            "\n"
-            "Axis parameters\n"
-            "  0x6081,0=100\n"          # indented: does not begin with a digit, the drive skips it
-            "-1,0=5\n"
-            "x0x6083,0=1\n"
-            "24705, 0=2000\r\n")
+    text = (
+        "; saved by the drive\n"
+        "0x6060,0=-3 ; trailing comment\n"
+        "\n"
+        "Axis parameters\n"
+        "  0x6081,0=100\n"  # indented: does not begin with a digit, the drive skips it
+        "-1,0=5\n"
+        "x0x6083,0=1\n"
+        "24705, 0=2000\r\n"
+    )
     entries = parse_object_file(text, "USER_PAR.TXT")
     assert entries == [ObjectEntry(0x6060, 0, -3), ObjectEntry(0x6081, 0, 2000)]
     assert [entry.line for entry in entries] == [2, 8]
@@ -59,22 +62,25 @@ def test_values_are_numbers_or_raw_text() -> None:
     assert [entry.value for entry in entries] == ["Axis X", 255, 7, 7]
 
 
-@pytest.mark.parametrize(("line", "reason"), [
-    ("0x3549=1", "exactly one comma"),
-    ("0x3549,1,2=1", "exactly one comma"),
-    ("0x3549,10", "no '='"),
-    ("0x3549,10=", "missing value"),
-    ("0x3549,10= ; nothing", "missing value"),
-    ("0x35G9,10=1", "index '0x35G9' is not a decimal or 0x hex number"),
-    ("0x3549,ten=1", "sub-index 'ten' is not a decimal or 0x hex number"),
-    ("0x3549, =1", "sub-index '' is not"),
-    ("0x13549,1=1", "index 0x13549 out of range 0..0xFFFF"),
-    ("0x3549,256=1", "sub-index 256 out of range 0..0xFF"),
-    ("0x3549,-1=1", "sub-index -1 out of range"),
-    ("0x3549,1=0x", "value '0x' is not a decimal or 0x hex number"),
-    ("0x3549,1=12abc", "value '12abc' is not"),
-    ("0x3549,1=-0x1G", "value '-0x1G' is not"),
-])
+@pytest.mark.parametrize(
+    ("line", "reason"),
+    [
+        ("0x3549=1", "exactly one comma"),
+        ("0x3549,1,2=1", "exactly one comma"),
+        ("0x3549,10", "no '='"),
+        ("0x3549,10=", "missing value"),
+        ("0x3549,10= ; nothing", "missing value"),
+        ("0x35G9,10=1", "index '0x35G9' is not a decimal or 0x hex number"),
+        ("0x3549,ten=1", "sub-index 'ten' is not a decimal or 0x hex number"),
+        ("0x3549, =1", "sub-index '' is not"),
+        ("0x13549,1=1", "index 0x13549 out of range 0..0xFFFF"),
+        ("0x3549,256=1", "sub-index 256 out of range 0..0xFF"),
+        ("0x3549,-1=1", "sub-index -1 out of range"),
+        ("0x3549,1=0x", "value '0x' is not a decimal or 0x hex number"),
+        ("0x3549,1=12abc", "value '12abc' is not"),
+        ("0x3549,1=-0x1G", "value '-0x1G' is not"),
+    ],
+)
 def test_malformed_lines_starting_with_a_digit_are_rejected(line: str, reason: str) -> None:
     text = "; header\n0x1000,0=1\n" + line + "\n0x1001,0=1\n"
     with pytest.raises(ObjectFileError) as caught:
@@ -96,29 +102,31 @@ def test_validation_hook_rejects_with_the_line() -> None:
 
 
 def test_writer_is_canonical_sorted_and_commented() -> None:
-    entries = [ObjectEntry(0x6081, 0, 0x10), ObjectEntry(0x2004, 0, "Axis X"), ObjectEntry(0x3549, 10, -18),
-               ObjectEntry(0x3549, 2, 5)]
+    entries = [
+        ObjectEntry(0x6081, 0, 0x10),
+        ObjectEntry(0x2004, 0, "Axis X"),
+        ObjectEntry(0x3549, 10, -18),
+        ObjectEntry(0x3549, 2, 5),
+    ]
     assert format_object_file(entries, header="DRIVEPAR.TXT\n\nnode 3") == (
-        "; DRIVEPAR.TXT\n"
-        ";\n"
-        "; node 3\n"
-        "0x2004,0=Axis X\n"
-        "0x3549,2=5\n"
-        "0x3549,10=-18\n"
-        "0x6081,0=16\n")
+        "; DRIVEPAR.TXT\n;\n; node 3\n0x2004,0=Axis X\n0x3549,2=5\n0x3549,10=-18\n0x6081,0=16\n"
+    )
     assert format_object_file([]) == ""
 
 
-@pytest.mark.parametrize(("entry", "reason"), [
-    (ObjectEntry(0x10000, 0, 1), "out of range"),
-    (ObjectEntry(0x1000, 256, 1), "out of range"),
-    (ObjectEntry(0x2004, 0, "1st axis"), "starts like a number"),
-    (ObjectEntry(0x2004, 0, "a;b"), "contains ';'"),
-    (ObjectEntry(0x2004, 0, "a\nb"), "line break"),
-    (ObjectEntry(0x2004, 0, " padded"), "leading/trailing spaces"),
-    (ObjectEntry(0x2004, 0, ""), "empty"),
-    (ObjectEntry(0x2004, 0, "axe \u2192"), "latin-1"),
-])
+@pytest.mark.parametrize(
+    ("entry", "reason"),
+    [
+        (ObjectEntry(0x10000, 0, 1), "out of range"),
+        (ObjectEntry(0x1000, 256, 1), "out of range"),
+        (ObjectEntry(0x2004, 0, "1st axis"), "starts like a number"),
+        (ObjectEntry(0x2004, 0, "a;b"), "contains ';'"),
+        (ObjectEntry(0x2004, 0, "a\nb"), "line break"),
+        (ObjectEntry(0x2004, 0, " padded"), "leading/trailing spaces"),
+        (ObjectEntry(0x2004, 0, ""), "empty"),
+        (ObjectEntry(0x2004, 0, "axe \u2192"), "latin-1"),
+    ],
+)
 def test_writer_refuses_entries_that_would_not_read_back(entry: ObjectEntry, reason: str) -> None:
     with pytest.raises(ValueError, match=reason):
         format_object_file([entry])
@@ -170,7 +178,8 @@ _TEXT_REST = st.text(alphabet=st.sampled_from("abcXYZ019 _-.,:=#\u00e9"), max_si
 _TEXT_VALUES = st.builds(lambda first, rest: (first + rest).rstrip() or first, _TEXT_START, _TEXT_REST)
 _VALUES = st.one_of(st.integers(-(2**63), 2**64), _TEXT_VALUES)
 _ENTRY_LISTS = st.dictionaries(st.tuples(st.integers(0, 0xFFFF), st.integers(0, 0xFF)), _VALUES, max_size=40).map(
-    lambda mapping: [ObjectEntry(index, sub, value) for (index, sub), value in mapping.items()])
+    lambda mapping: [ObjectEntry(index, sub, value) for (index, sub), value in mapping.items()]
+)
 
 
 @settings(deadline=None)
@@ -190,8 +199,13 @@ def test_any_spelling_of_an_entry_reads_the_same(entries: list[ObjectEntry], dat
     for entry in entries:
         index = data.draw(st.sampled_from([str(entry.index), f"0x{entry.index:x}", f"0X{entry.index:04X}"]))
         sub = data.draw(st.sampled_from([str(entry.sub), f"0x{entry.sub:X}", f" {entry.sub}"]))
-        value = entry.value if isinstance(entry.value, str) else data.draw(st.sampled_from(
-            [str(entry.value), f"{'-' if entry.value < 0 else ''}0x{abs(entry.value):x}"]))
+        value = (
+            entry.value
+            if isinstance(entry.value, str)
+            else data.draw(
+                st.sampled_from([str(entry.value), f"{'-' if entry.value < 0 else ''}0x{abs(entry.value):x}"])
+            )
+        )
         comment = data.draw(st.sampled_from(["", " ; note", ";"]))
         noise = data.draw(st.sampled_from(["", "; comment\n", "\n", "Title line\n", "\t0x1,1=1\n"]))
         lines.append(f"{noise}{index},{sub}={value}{comment}\n")

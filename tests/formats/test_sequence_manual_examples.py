@@ -37,12 +37,12 @@ def test_manual_file_example_with_times_in_range_reads_as_the_manual_describes()
     positioning, speed = table[1], table[3]
     assert positioning.type is SequenceType.POS
     assert positioning["Pos"] == 0x1000
-    assert positioning["PosType"] == 0                       # ABS
+    assert positioning["PosType"] == 0  # ABS
     assert positioning["Speed"] == 100000
     assert positioning["Output"] == BitPattern(zeros=0b0011_0111, ones=0b0000_1000)
-    assert positioning["Trigger"] == 1                       # BEGIN = bit 0 of sub 5
+    assert positioning["Trigger"] == 1  # BEGIN = bit 0 of sub 5
     assert (positioning["Tempo"], positioning["SeqNext"]) == (1000, 3)
-    assert (positioning["Accel"], positioning["Decel"]) == (100000, 100000)   # from the Default block
+    assert (positioning["Accel"], positioning["Decel"]) == (100000, 100000)  # from the Default block
     assert speed.type is SequenceType.SPEED
     assert (speed["AccelTime"], speed["DecelTime"], speed["Speed"], speed["RunTime"]) == (2000, 2000, 500000, 10000)
     subs = positioning.to_object_values()
@@ -61,23 +61,27 @@ def test_manual_two_positioning_sequences_without_stopping() -> None:
 
 def test_manual_combined_speed_sequences() -> None:
     table = read_sequence_file(FIXTURES / "manual_speed_chain.txt")
-    assert {number: (seq["Speed"], seq["AccelTime"], seq["RunTime"], seq["DecelTime"], seq["SeqNext"])
-            for number, seq in table.sequences.items()} == {
-        1: (150000, 400, 0, 0, 2), 2: (250000, 400, 0, 0, 3), 3: (140000, 400, 0, 150, -1)}
+    assert {
+        number: (seq["Speed"], seq["AccelTime"], seq["RunTime"], seq["DecelTime"], seq["SeqNext"])
+        for number, seq in table.sequences.items()
+    } == {1: (150000, 400, 0, 0, 2), 2: (250000, 400, 0, 0, 3), 3: (140000, 400, 0, 150, -1)}
     subs = table[3].to_object_values()
     assert (subs[1], subs[15], subs[19], subs[20], subs[24]) == (3, 140000, 400, 150, 0)
 
 
 def test_manual_counter_loop() -> None:
     table = read_sequence_file(FIXTURES / "manual_counter_loop.txt")
-    assert {number: (seq["SeqCount"], seq["SeqNext"], seq["SeqLink"]) for number, seq in table.sequences.items()} \
-        == {1: (0, 2, -1), 2: (2, 3, 1), 3: (0, -1, -1)}
+    assert {number: (seq["SeqCount"], seq["SeqNext"], seq["SeqLink"]) for number, seq in table.sequences.items()} == {
+        1: (0, 2, -1),
+        2: (2, 3, 1),
+        3: (0, -1, -1),
+    }
     assert all(seq.type is SequenceType.POS for seq in table.sequences.values())
 
 
 def test_manual_conditional_jump_pattern_is_msb_first() -> None:
     table = read_sequence_file(FIXTURES / "manual_conditional_jump.txt")
-    assert table[2]["StartCond"] == BitPattern(zeros=0, ones=0x80)     # "1......." = logic input 8 = bit 7
+    assert table[2]["StartCond"] == BitPattern(zeros=0, ones=0x80)  # "1......." = logic input 8 = bit 7
     assert (table[2]["SeqNext"], table[2]["SeqLink"]) == (3, 4)
     subs = table[2].to_object_values()
     assert (subs[9], subs[10]) == (0, 0x80)

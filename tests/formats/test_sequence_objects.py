@@ -15,28 +15,78 @@ from servostudio.formats.sequence import (
     parse_sequence_text,
 )
 
-HOME = Sequence.of(SequenceType.HOME, HomeOfs=-500, Speed=2000, Speed2=100, Accel=20, Decel=30, Method=-2,
-                   Torque=400, Tempo=5, Trigger=32, Output=BitPattern(zeros=1, ones=2),
-                   StartCond=BitPattern(ones=4), EndCond=BitPattern(zeros=8), SeqNext=4, SeqCount=3, SeqLink=0)
+HOME = Sequence.of(
+    SequenceType.HOME,
+    HomeOfs=-500,
+    Speed=2000,
+    Speed2=100,
+    Accel=20,
+    Decel=30,
+    Method=-2,
+    Torque=400,
+    Tempo=5,
+    Trigger=32,
+    Output=BitPattern(zeros=1, ones=2),
+    StartCond=BitPattern(ones=4),
+    EndCond=BitPattern(zeros=8),
+    SeqNext=4,
+    SeqCount=3,
+    SeqLink=0,
+)
 
 
 def test_home_sequence_fills_every_sub_of_0x3611() -> None:
     assert HOME.to_object_values() == {
-        1: 2, 2: 4, 3: 3, 4: 0, 5: 32, 6: 1, 7: 2, 8: 0, 9: 0, 10: 4, 11: 8, 12: 0,
-        13: -500, 14: 0, 15: 2000, 16: 100, 17: 0, 18: 0, 19: 20, 20: 30, 21: 0, 22: -2, 23: 5, 24: 0,
-        25: 400, 26: 0}
+        1: 2,
+        2: 4,
+        3: 3,
+        4: 0,
+        5: 32,
+        6: 1,
+        7: 2,
+        8: 0,
+        9: 0,
+        10: 4,
+        11: 8,
+        12: 0,
+        13: -500,
+        14: 0,
+        15: 2000,
+        16: 100,
+        17: 0,
+        18: 0,
+        19: 20,
+        20: 30,
+        21: 0,
+        22: -2,
+        23: 5,
+        24: 0,
+        25: 400,
+        26: 0,
+    }
 
 
-@pytest.mark.parametrize(("sequence", "expected"), [
-    (Sequence.of(SequenceType.POS, Pos=7, PosType=1, Speed=8, Speed2=9, Accel=10, Decel=11),
-     {13: 7, 21: 1, 15: 8, 16: 9, 17: 10, 18: 11}),
-    (Sequence.of(SequenceType.SPEED, Speed=8, AccelTime=10, DecelTime=11, RunTime=65535),
-     {15: 8, 19: 10, 20: 11, 24: 65535}),
-    (Sequence.of(SequenceType.TORQUE, Speed=-8, Accel=10, Decel=11, RunTime=12, Torque=13),
-     {15: -8, 19: 10, 20: 11, 24: 12, 25: 13}),
-    (Sequence.of(SequenceType.GEAR, Config=3, Factor=-4, Speed=5, Accel=6, MasterDtn=7, SlaveDtn=8, SyncDtn=9),
-     {21: 3, 26: -4, 15: 5, 19: 6, 13: 7, 14: 8, 16: 9}),
-])
+@pytest.mark.parametrize(
+    ("sequence", "expected"),
+    [
+        (
+            Sequence.of(SequenceType.POS, Pos=7, PosType=1, Speed=8, Speed2=9, Accel=10, Decel=11),
+            {13: 7, 21: 1, 15: 8, 16: 9, 17: 10, 18: 11},
+        ),
+        (
+            Sequence.of(SequenceType.SPEED, Speed=8, AccelTime=10, DecelTime=11, RunTime=65535),
+            {15: 8, 19: 10, 20: 11, 24: 65535},
+        ),
+        (
+            Sequence.of(SequenceType.TORQUE, Speed=-8, Accel=10, Decel=11, RunTime=12, Torque=13),
+            {15: -8, 19: 10, 20: 11, 24: 12, 25: 13},
+        ),
+        (
+            Sequence.of(SequenceType.GEAR, Config=3, Factor=-4, Speed=5, Accel=6, MasterDtn=7, SlaveDtn=8, SyncDtn=9),
+            {21: 3, 26: -4, 15: 5, 19: 6, 13: 7, 14: 8, 16: 9},
+        ),
+    ],
+)
 def test_type_specific_keywords_land_in_their_subs(sequence: Sequence, expected: dict[int, int]) -> None:
     record = sequence.to_object_values()
     assert {sub: record[sub] for sub in expected} == expected
@@ -55,17 +105,20 @@ def test_subs_a_type_does_not_use_are_ignored() -> None:
     assert Sequence.from_object_values(record) == Sequence.of(SequenceType.SPEED, Speed=5)
 
 
-@pytest.mark.parametrize(("changes", "reason"), [
-    ({1: 6}, "CAM"),
-    ({1: 9}, "sequence type 9"),
-    ({8: 1}, "0x3611,8 (Output Bits Toggle)"),
-    ({5: 16}, "Trigger: 16 has no constant"),
-    ({5: 33}, "Trigger: 33 has no constant"),
-    ({7: 0x100}, "Output (0x3611,6/7): pattern bits must be within bits 0..7"),
-    ({9: 4, 10: 4}, "StartCond (0x3611,9/10): pattern bits 0x4 cannot be both 0 and 1"),
-    ({23: 20000}, "Tempo: value 20000 is out of range: allowed 0..16000"),
-    ({2: 200}, "SeqNext: value 200 is out of range: allowed -1..127"),
-])
+@pytest.mark.parametrize(
+    ("changes", "reason"),
+    [
+        ({1: 6}, "CAM"),
+        ({1: 9}, "sequence type 9"),
+        ({8: 1}, "0x3611,8 (Output Bits Toggle)"),
+        ({5: 16}, "Trigger: 16 has no constant"),
+        ({5: 33}, "Trigger: 33 has no constant"),
+        ({7: 0x100}, "Output (0x3611,6/7): pattern bits must be within bits 0..7"),
+        ({9: 4, 10: 4}, "StartCond (0x3611,9/10): pattern bits 0x4 cannot be both 0 and 1"),
+        ({23: 20000}, "Tempo: value 20000 is out of range: allowed 0..16000"),
+        ({2: 200}, "SeqNext: value 200 is out of range: allowed -1..127"),
+    ],
+)
 def test_values_a_file_cannot_express_are_refused(changes: dict[int, int], reason: str) -> None:
     record = {**Sequence.of(SequenceType.POS).to_object_values(), **changes}
     with pytest.raises(ValueError) as caught:
@@ -88,13 +141,16 @@ def test_drive_defaults_outside_the_file_range_are_kept_and_left_out_of_the_file
     assert parse_sequence_text(text) == table
 
 
-@pytest.mark.parametrize(("kind", "values", "reason"), [
-    (SequenceType.POS, {"Method": 1}, "not parameters of a POS sequence: Method"),
-    (SequenceType.SPEED, {"AccelTime": 70000}, "AccelTime: value 70000 is out of range: allowed 1..65535"),
-    (SequenceType.POS, {"Output": 5}, "Output: needs a bit pattern"),
-    (SequenceType.POS, {"Speed": BitPattern()}, "Speed: needs a number"),
-    (SequenceType.POS, {"Trigger": 3}, "Trigger: 3 has no constant"),
-])
+@pytest.mark.parametrize(
+    ("kind", "values", "reason"),
+    [
+        (SequenceType.POS, {"Method": 1}, "not parameters of a POS sequence: Method"),
+        (SequenceType.SPEED, {"AccelTime": 70000}, "AccelTime: value 70000 is out of range: allowed 1..65535"),
+        (SequenceType.POS, {"Output": 5}, "Output: needs a bit pattern"),
+        (SequenceType.POS, {"Speed": BitPattern()}, "Speed: needs a number"),
+        (SequenceType.POS, {"Trigger": 3}, "Trigger: 3 has no constant"),
+    ],
+)
 def test_invalid_sequences_cannot_be_built(kind: SequenceType, values: dict, reason: str) -> None:
     with pytest.raises(ValueError) as caught:
         Sequence(kind, values)
@@ -135,8 +191,13 @@ def test_table_from_object_records() -> None:
         SequenceTable.from_object_values({7: {1: 6}})
 
 
-MEMORY = SequenceTable({0: Sequence.of(SequenceType.POS, Pos=1), 1: Sequence.of(SequenceType.POS, Pos=2),
-                        2: Sequence.of(SequenceType.POS, Pos=3, Speed=50)})
+MEMORY = SequenceTable(
+    {
+        0: Sequence.of(SequenceType.POS, Pos=1),
+        1: Sequence.of(SequenceType.POS, Pos=2),
+        2: Sequence.of(SequenceType.POS, Pos=3, Speed=50),
+    }
+)
 FILE = parse_sequence_text("SeqNb=2\nSeqType=POS\nPos=30\nSeqNb=9\nSeqType=SPEED\nSpeed=9\n")
 
 

@@ -25,7 +25,8 @@ from servostudio.formats.sequence_model import default_value, value_problem
 from servostudio.formats.sequence_spec import Keyword
 
 PATTERNS = st.tuples(st.integers(0, 255), st.integers(0, 255)).map(
-    lambda pair: BitPattern(zeros=pair[0] & ~pair[1], ones=pair[1]))
+    lambda pair: BitPattern(zeros=pair[0] & ~pair[1], ones=pair[1])
+)
 
 
 def values_of(keyword: Keyword) -> st.SearchStrategy:
@@ -104,20 +105,50 @@ def test_any_allowed_spelling_reads_as_the_table(table: SequenceTable, data: st.
         for keyword in keywords_for(sequence.type):
             value = sequence[keyword.name]
             if value_problem(keyword, value) is not None:
-                continue                                   # a drive default the syntax cannot spell
+                continue  # a drive default the syntax cannot spell
             if value == default_value(keyword) and data.draw(st.booleans()):
-                continue                                   # rule 9: undeclared means default
+                continue  # rule 9: undeclared means default
             body.append(spelled(keyword, value, data))
         lines.extend(data.draw(st.permutations(body)))
         lines.extend(data.draw(st.sampled_from([[], [""], ["; next sequence"]])))
     assert parse_sequence_text("\n".join(lines)) == table
 
 
-FRAGMENTS = st.sampled_from([
-    "SeqNb=", "SeqType=", "POS", "speed", "HOME", "Torque", "GEAR", "Default", "Accel", "AccelTime", "Decel",
-    "Pos", "Method", "Output", "StartCond", '"..01..10"', '"1"', "=", ";", "\n", " ", "1", "-1", "0x", "70000",
-    "Trigger", "begin", "SeqNext", "Tempo", "RunTime", "Factor",
-])
+FRAGMENTS = st.sampled_from(
+    [
+        "SeqNb=",
+        "SeqType=",
+        "POS",
+        "speed",
+        "HOME",
+        "Torque",
+        "GEAR",
+        "Default",
+        "Accel",
+        "AccelTime",
+        "Decel",
+        "Pos",
+        "Method",
+        "Output",
+        "StartCond",
+        '"..01..10"',
+        '"1"',
+        "=",
+        ";",
+        "\n",
+        " ",
+        "1",
+        "-1",
+        "0x",
+        "70000",
+        "Trigger",
+        "begin",
+        "SeqNext",
+        "Tempo",
+        "RunTime",
+        "Factor",
+    ]
+)
 
 
 @settings(deadline=None)

@@ -36,10 +36,12 @@ def single_issue(text: str, **options: int) -> SequenceIssue:
 
 # Rule 1: text file; keywords and constants are not case-sensitive (spaces inside a keyword do not matter either).
 def test_rule1_keywords_and_constants_ignore_case_and_inner_spaces() -> None:
-    table = parse_sequence_text("seqnb=1\nSEQTYPE=Pos\nposition=5\npostype=rel\nstart cond=\"1.......\"\n"
-                                "NEXTSEQ=2\ntrigger=Cruise\n")
-    assert table[1] == Sequence.of(SequenceType.POS, Pos=5, PosType=1, StartCond=BitPattern(ones=0x80),
-                                   SeqNext=2, Trigger=2)
+    table = parse_sequence_text(
+        'seqnb=1\nSEQTYPE=Pos\nposition=5\npostype=rel\nstart cond="1......."\nNEXTSEQ=2\ntrigger=Cruise\n'
+    )
+    assert table[1] == Sequence.of(
+        SequenceType.POS, Pos=5, PosType=1, StartCond=BitPattern(ones=0x80), SeqNext=2, Trigger=2
+    )
 
 
 def test_rule1_text_with_crlf_line_ends_keeps_line_numbers() -> None:
@@ -83,13 +85,16 @@ def test_rule3_malformed_number_is_rejected(value: str) -> None:
     assert "is not a number (decimal or 0x hex)" in issue.reason
 
 
-@pytest.mark.parametrize(("line", "keyword", "allowed"), [
-    ("SeqType=JOG", "SeqType", "allowed: POS, HOME, SPEED, TORQUE, GEAR"),
-    ("SeqType=1", "SeqType", "allowed: POS, HOME"),
-    ("PosType=RELATIVE", "PosType", "allowed: ABS, REL"),
-    ("Trigger=INPOS", "Trigger", "allowed: BEGIN, CRUISE, DECEL, HOLD, END"),
-    ("Trigger=BEGIN|END", "Trigger", "allowed: BEGIN"),
-])
+@pytest.mark.parametrize(
+    ("line", "keyword", "allowed"),
+    [
+        ("SeqType=JOG", "SeqType", "allowed: POS, HOME, SPEED, TORQUE, GEAR"),
+        ("SeqType=1", "SeqType", "allowed: POS, HOME"),
+        ("PosType=RELATIVE", "PosType", "allowed: ABS, REL"),
+        ("Trigger=INPOS", "Trigger", "allowed: BEGIN, CRUISE, DECEL, HOLD, END"),
+        ("Trigger=BEGIN|END", "Trigger", "allowed: BEGIN"),
+    ],
+)
 def test_rule3_unknown_constant_is_rejected(line: str, keyword: str, allowed: str) -> None:
     issues = issues_of(f"SeqNb=1\n{line}\nSeqType=POS\n" if keyword != "SeqType" else f"SeqNb=1\n{line}\n")
     assert (issues[0].line, issues[0].keyword) == (2, keyword)
@@ -118,11 +123,14 @@ def test_rule5_parameter_before_any_seqnb_is_rejected() -> None:
     assert "a sequence begins with SeqNb" in issues[0].reason
 
 
-@pytest.mark.parametrize(("value", "reason"), [
-    ("x", "'x' is not a sequence number (decimal or 0x hex)"),
-    ("128", "sequence number 128 is out of range: allowed 0..127"),
-    ("-1", "sequence number -1 is out of range: allowed 0..127"),
-])
+@pytest.mark.parametrize(
+    ("value", "reason"),
+    [
+        ("x", "'x' is not a sequence number (decimal or 0x hex)"),
+        ("128", "sequence number 128 is out of range: allowed 0..127"),
+        ("-1", "sequence number -1 is out of range: allowed 0..127"),
+    ],
+)
 def test_rule5_bad_sequence_number_is_rejected(value: str, reason: str) -> None:
     issue = single_issue(f"SeqNb={value}\nSeqType=POS\n")
     assert (issue.line, issue.keyword, issue.reason) == (1, "SeqNb", reason)
@@ -144,7 +152,7 @@ def test_rule6_parameter_order_does_not_matter() -> None:
     forward = parse_sequence_text("SeqNb=1\nSeqType=HOME\nMethod=-2\nTorque=300\nAccel=50\n")
     backward = parse_sequence_text("SeqNb=1\nAccel=50\nTorque=300\nMethod=-2\nSeqType=HOME\n")
     assert forward == backward
-    assert forward[1].to_object_values()[19] == 50     # HOME Accel is sub 19, resolved once the type is known
+    assert forward[1].to_object_values()[19] == 50  # HOME Accel is sub 19, resolved once the type is known
 
 
 # Rule 7: no end marker; the next SeqNb ends the current sequence.
@@ -159,28 +167,31 @@ def test_rule7_sequence_number_declared_twice_is_rejected() -> None:
 
 
 # Rule 8: incoherent parameters or out-of-limit values are errors.
-@pytest.mark.parametrize(("kind", "line", "allowed"), [
-    ("POS", "Tempo=16001", "allowed 0..16000"),
-    ("POS", "SeqNext=128", "allowed -1..127"),
-    ("POS", "SeqLink=-2", "allowed -1..127"),
-    ("POS", "SeqCount=65536", "allowed 0..65535"),
-    ("POS", "Pos=2147483648", "allowed -2147483648..2147483647"),
-    ("POS", "Speed=-2147483649", "allowed -2147483648..2147483647"),
-    ("POS", "Accel=-1", "allowed 0..4294967295"),
-    ("POS", "Decel=0x100000000", "allowed 0..4294967295"),
-    ("SPEED", "AccelTime=0", "allowed 1..65535"),
-    ("SPEED", "AccelTime=200000", "allowed 1..65535"),
-    ("SPEED", "DecelTime=65536", "allowed 0..65535"),
-    ("SPEED", "RunTime=-1", "allowed 0..65535"),
-    ("HOME", "Method=15", "allowed -4..-1, 1..14, 17..30, 33..35"),
-    ("HOME", "Method=0", "allowed -4..-1"),
-    ("HOME", "Torque=32768", "allowed -32768..32767"),
-    ("HOME", "Accel=65536", "allowed 1..65535"),
-    ("TORQUE", "Current Limit=-32769", "allowed -32768..32767"),
-    ("GEAR", "Config=65536", "allowed 0..65535"),
-    ("GEAR", "Factor=40000", "allowed -32768..32767"),
-    ("GEAR", "SyncDtn=0x80000000", "allowed -2147483648..2147483647"),
-])
+@pytest.mark.parametrize(
+    ("kind", "line", "allowed"),
+    [
+        ("POS", "Tempo=16001", "allowed 0..16000"),
+        ("POS", "SeqNext=128", "allowed -1..127"),
+        ("POS", "SeqLink=-2", "allowed -1..127"),
+        ("POS", "SeqCount=65536", "allowed 0..65535"),
+        ("POS", "Pos=2147483648", "allowed -2147483648..2147483647"),
+        ("POS", "Speed=-2147483649", "allowed -2147483648..2147483647"),
+        ("POS", "Accel=-1", "allowed 0..4294967295"),
+        ("POS", "Decel=0x100000000", "allowed 0..4294967295"),
+        ("SPEED", "AccelTime=0", "allowed 1..65535"),
+        ("SPEED", "AccelTime=200000", "allowed 1..65535"),
+        ("SPEED", "DecelTime=65536", "allowed 0..65535"),
+        ("SPEED", "RunTime=-1", "allowed 0..65535"),
+        ("HOME", "Method=15", "allowed -4..-1, 1..14, 17..30, 33..35"),
+        ("HOME", "Method=0", "allowed -4..-1"),
+        ("HOME", "Torque=32768", "allowed -32768..32767"),
+        ("HOME", "Accel=65536", "allowed 1..65535"),
+        ("TORQUE", "Current Limit=-32769", "allowed -32768..32767"),
+        ("GEAR", "Config=65536", "allowed 0..65535"),
+        ("GEAR", "Factor=40000", "allowed -32768..32767"),
+        ("GEAR", "SyncDtn=0x80000000", "allowed -2147483648..2147483647"),
+    ],
+)
 def test_rule8_out_of_limit_value_names_line_keyword_and_range(kind: str, line: str, allowed: str) -> None:
     keyword = line.split("=")[0]
     issue = single_issue(f"SeqNb=7\nSeqType={kind}\n{line}\n")
@@ -188,20 +199,40 @@ def test_rule8_out_of_limit_value_names_line_keyword_and_range(kind: str, line: 
     assert "out of range" in issue.reason and allowed in issue.reason and f"{kind} sequence 7" in issue.reason
 
 
-@pytest.mark.parametrize(("kind", "line"), [
-    ("POS", "Tempo=16000"), ("POS", "SeqNext=-1"), ("POS", "SeqLink=127"), ("POS", "Accel=4294967295"),
-    ("SPEED", "AccelTime=1"), ("SPEED", "AccelTime=65535"), ("SPEED", "RunTime=65535"),
-    ("HOME", "Method=-4"), ("HOME", "Method=35"), ("HOME", "Method=17"), ("GEAR", "Factor=-32768"),
-])
+@pytest.mark.parametrize(
+    ("kind", "line"),
+    [
+        ("POS", "Tempo=16000"),
+        ("POS", "SeqNext=-1"),
+        ("POS", "SeqLink=127"),
+        ("POS", "Accel=4294967295"),
+        ("SPEED", "AccelTime=1"),
+        ("SPEED", "AccelTime=65535"),
+        ("SPEED", "RunTime=65535"),
+        ("HOME", "Method=-4"),
+        ("HOME", "Method=35"),
+        ("HOME", "Method=17"),
+        ("GEAR", "Factor=-32768"),
+    ],
+)
 def test_rule8_limits_themselves_are_accepted(kind: str, line: str) -> None:
     keyword, value = line.split("=")
     assert parse_sequence_text(f"SeqNb=7\nSeqType={kind}\n{line}\n")[7][keyword] == int(value)
 
 
-@pytest.mark.parametrize(("kind", "line"), [
-    ("POS", "Method=1"), ("POS", "RunTime=5"), ("SPEED", "Pos=1"), ("SPEED", "PosType=ABS"),
-    ("HOME", "Pos=1"), ("TORQUE", "Speed2=1"), ("GEAR", "Decel=5"), ("GEAR", "DecelTime=5"),
-])
+@pytest.mark.parametrize(
+    ("kind", "line"),
+    [
+        ("POS", "Method=1"),
+        ("POS", "RunTime=5"),
+        ("SPEED", "Pos=1"),
+        ("SPEED", "PosType=ABS"),
+        ("HOME", "Pos=1"),
+        ("TORQUE", "Speed2=1"),
+        ("GEAR", "Decel=5"),
+        ("GEAR", "DecelTime=5"),
+    ],
+)
 def test_rule8_keyword_of_another_sequence_type_is_rejected(kind: str, line: str) -> None:
     issue = single_issue(f"SeqNb=1\nSeqType={kind}\n{line}\n")
     assert (issue.line, issue.keyword) == (3, line.split("=")[0])
@@ -213,12 +244,15 @@ def test_rule8_unknown_keyword_is_rejected() -> None:
     assert (issue.line, issue.keyword, issue.reason) == (3, "Velocity", "unknown keyword")
 
 
-@pytest.mark.parametrize(("first", "second", "name"), [
-    ("Speed=1", "speed=2", "Speed"),
-    ("Accel=1", "AccelTime=2", "Accel"),          # POS: the two spellings are one parameter
-    ("NextSeq=1", "SeqNext=2", "SeqNext"),
-    ("Pos=1", "Position=2", "Pos"),
-])
+@pytest.mark.parametrize(
+    ("first", "second", "name"),
+    [
+        ("Speed=1", "speed=2", "Speed"),
+        ("Accel=1", "AccelTime=2", "Accel"),  # POS: the two spellings are one parameter
+        ("NextSeq=1", "SeqNext=2", "SeqNext"),
+        ("Pos=1", "Position=2", "Pos"),
+    ],
+)
 def test_rule8_parameter_declared_twice_is_rejected(first: str, second: str, name: str) -> None:
     issue = single_issue(f"SeqNb=1\nSeqType=POS\n{first}\n{second}\n")
     assert (issue.line, issue.keyword) == (4, second.split("=")[0])
@@ -241,17 +275,29 @@ def test_rule8_sequence_without_type_is_rejected() -> None:
 def test_rule9_builtin_defaults() -> None:
     sequence = parse_sequence_text("SeqNb=0\nSeqType=SPEED\n")[0]
     assert dict(sequence.values) == {
-        "Speed": 0, "AccelTime": 0, "DecelTime": 0, "RunTime": 0, "Tempo": 0, "Trigger": 0,
-        "Output": BitPattern(), "StartCond": BitPattern(), "EndCond": BitPattern(),
-        "SeqNext": -1, "SeqCount": 0, "SeqLink": -1}
+        "Speed": 0,
+        "AccelTime": 0,
+        "DecelTime": 0,
+        "RunTime": 0,
+        "Tempo": 0,
+        "Trigger": 0,
+        "Output": BitPattern(),
+        "StartCond": BitPattern(),
+        "EndCond": BitPattern(),
+        "SeqNext": -1,
+        "SeqCount": 0,
+        "SeqLink": -1,
+    }
 
 
 def test_rule9_default_block_applies_to_undeclared_parameters_of_later_sequences() -> None:
-    text = ("Default\nSpeed=1000\nAccel=50\nTempo=20\n"
-            "SeqNb=1\nSeqType=POS\nSpeed=5\n"           # Accel (sub 17) and Tempo from the defaults
-            "SeqNb=2\nSeqType=SPEED\n"                  # AccelTime takes the Accel default (one parameter)
-            "Default\nSpeed=2000\n"                     # changes the default for what follows only
-            "SeqNb=3\nSeqType=TORQUE\n")
+    text = (
+        "Default\nSpeed=1000\nAccel=50\nTempo=20\n"
+        "SeqNb=1\nSeqType=POS\nSpeed=5\n"  # Accel (sub 17) and Tempo from the defaults
+        "SeqNb=2\nSeqType=SPEED\n"  # AccelTime takes the Accel default (one parameter)
+        "Default\nSpeed=2000\n"  # changes the default for what follows only
+        "SeqNb=3\nSeqType=TORQUE\n"
+    )
     table = parse_sequence_text(text)
     assert (table[1]["Speed"], table[1]["Accel"], table[1]["Tempo"]) == (5, 50, 20)
     assert (table[2]["Speed"], table[2]["AccelTime"], table[2]["Tempo"]) == (1000, 50, 20)
@@ -299,13 +345,19 @@ def test_malformed_pattern_is_rejected(value: str) -> None:
 
 # Whole-file behaviour: every error is reported, and no table comes back from a file with any error.
 def test_all_errors_are_collected_in_line_order() -> None:
-    text = ("SeqNb=1\nSeqType=POS\nTempo=99999\nMethod=3\n"
-            "SeqNb=2\nSeqType=SPEED\nAccelTime=0\n"
-            "SeqNb=3\nSeqType=GEAR\nFactor=1\n"          # a valid sequence among broken ones
-            "nonsense\n")
+    text = (
+        "SeqNb=1\nSeqType=POS\nTempo=99999\nMethod=3\n"
+        "SeqNb=2\nSeqType=SPEED\nAccelTime=0\n"
+        "SeqNb=3\nSeqType=GEAR\nFactor=1\n"  # a valid sequence among broken ones
+        "nonsense\n"
+    )
     issues = issues_of(text)
     assert [(issue.line, issue.keyword) for issue in issues] == [
-        (3, "Tempo"), (4, "Method"), (7, "AccelTime"), (11, None)]
+        (3, "Tempo"),
+        (4, "Method"),
+        (7, "AccelTime"),
+        (11, None),
+    ]
 
 
 def test_a_file_with_any_error_yields_no_table(tmp_path: Path) -> None:

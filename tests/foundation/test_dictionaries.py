@@ -166,8 +166,10 @@ def test_unknown_dictionary_is_404_naming_the_known_ones(client: TestClient) -> 
 
 def test_import_user_eds_over_rest(client: TestClient, tmp_path: Path) -> None:
     eds = write_small_eds(tmp_path)
-    response = client.post("/api/dictionaries", files={"eds": ("acme.eds", eds.read_bytes()),
-                                                       "props": ("acme.props", SMALL_PROPS.encode())})
+    response = client.post(
+        "/api/dictionaries",
+        files={"eds": ("acme.eds", eds.read_bytes()), "props": ("acme.props", SMALL_PROPS.encode())},
+    )
     assert response.status_code == 201, response.text
     assert response.json()["builtin"] is False
     od = client.get("/api/dictionaries/acme").json()
@@ -177,7 +179,9 @@ def test_import_user_eds_over_rest(client: TestClient, tmp_path: Path) -> None:
 
 
 def test_bad_eds_is_refused_with_line_and_nothing_kept(client: TestClient, tmp_path: Path) -> None:
-    broken = SMALL_EDS.replace("DataType=0x0006\nAccessType=rw\nLowLimit=10", "DataType=0x0006\nAccessType=rw\nLowLimit=-10")
+    broken = SMALL_EDS.replace(
+        "DataType=0x0006\nAccessType=rw\nLowLimit=10", "DataType=0x0006\nAccessType=rw\nLowLimit=-10"
+    )
     response = client.post("/api/dictionaries", files={"eds": ("acme.eds", broken.encode())})
     assert response.status_code == 422
     detail = response.json()["detail"]

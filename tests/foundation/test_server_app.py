@@ -47,8 +47,10 @@ def test_missing_ui_build_says_how_to_build_it(tmp_path) -> None:
     assert "make run" in response.text
 
 
-@pytest.mark.parametrize("argv, host, port", [(["serve"], "127.0.0.1", 8000),
-                                              (["serve", "--host", "0.0.0.0", "--port", "9000"], "0.0.0.0", 9000)])
+@pytest.mark.parametrize(
+    "argv, host, port",
+    [(["serve"], "127.0.0.1", 8000), (["serve", "--host", "0.0.0.0", "--port", "9000"], "0.0.0.0", 9000)],
+)
 def test_serve_binds_localhost_by_default(argv, host, port) -> None:
     args = build_parser().parse_args(argv)
     assert (args.host, args.port) == (host, port)

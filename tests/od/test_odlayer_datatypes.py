@@ -110,8 +110,15 @@ def test_values_of_the_wrong_kind_are_refused(data_type: DataType, value: object
         encode(data_type, value)
 
 
-@pytest.mark.parametrize(("data_type", "raw"), [(DataType.UNSIGNED16, b"\x01"), (DataType.REAL64, b"\x00" * 4),
-                                                (DataType.UNICODE_STRING, b"\x41"), (DataType.BOOLEAN, b"\x02")])
+@pytest.mark.parametrize(
+    ("data_type", "raw"),
+    [
+        (DataType.UNSIGNED16, b"\x01"),
+        (DataType.REAL64, b"\x00" * 4),
+        (DataType.UNICODE_STRING, b"\x41"),
+        (DataType.BOOLEAN, b"\x02"),
+    ],
+)
 def test_bad_raw_bytes_are_refused(data_type: DataType, raw: bytes) -> None:
     with pytest.raises(EncodingError):
         decode(data_type, raw)

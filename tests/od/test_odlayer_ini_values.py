@@ -9,17 +9,21 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from servostudio.od import DataType, DictionaryError
+from servostudio.od.eds_values import ValueSyntaxError, float_bit_pattern, parse_integer, parse_value
 from servostudio.od.ini import format_ini, parse_ini
-from servostudio.od.values import ValueSyntaxError, float_bit_pattern, parse_integer, parse_value
 
 SAFE_CHARS = st.characters(blacklist_categories=("Cs", "Cc", "Zl", "Zp"), blacklist_characters="\x85\x1c\x1d\x1e")
 ASCII = st.characters(min_codepoint=0x20, max_codepoint=0x7E)  # CiA 306 keys and section names are ASCII
-keys = st.text(ASCII, min_size=1, max_size=12).map(str.strip).filter(
-    lambda k: k and "=" not in k and ";" not in k and not k.startswith("[")
+keys = (
+    st.text(ASCII, min_size=1, max_size=12)
+    .map(str.strip)
+    .filter(lambda k: k and "=" not in k and ";" not in k and not k.startswith("["))
 )
 values = st.text(SAFE_CHARS, max_size=20).map(str.strip).filter(lambda v: ";" not in v)
-names = st.text(ASCII, min_size=1, max_size=12).map(str.strip).filter(
-    lambda n: n and "[" not in n and "]" not in n and ";" not in n
+names = (
+    st.text(ASCII, min_size=1, max_size=12)
+    .map(str.strip)
+    .filter(lambda n: n and "[" not in n and "]" not in n and ";" not in n)
 )
 
 

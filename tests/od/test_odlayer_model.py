@@ -25,8 +25,13 @@ def od(write_files):
 
 
 def test_device_identity_and_sizes(od) -> None:
-    assert (od.device, od.product_name, od.vendor_id, od.product_code, od.revision) == ("mini", "Mini drive", 0x12,
-                                                                                       0x34, 1)
+    assert (od.device, od.product_name, od.vendor_id, od.product_code, od.revision) == (
+        "mini",
+        "Mini drive",
+        0x12,
+        0x34,
+        1,
+    )
     assert [obj.index for obj in od.objects()] == [0x1000, 0x1001, 0x1018, 0x1800, 0x2000, 0x2100, 0x6041]
     assert len(od) == 1 + 1 + 3 + 2 + 4 + 1 + 1
     assert [v.key for v in od.variables()][:3] == [(0x1000, 0), (0x1001, 0), (0x1018, 0)]
@@ -36,8 +41,11 @@ def test_device_identity_and_sizes(od) -> None:
 
 def test_entries_carry_eds_values(od) -> None:
     device_type = od[0x1000, 0]
-    assert (device_type.data_type, device_type.access, device_type.default) == (DataType.UNSIGNED32, Access.RO,
-                                                                                0x00020192)
+    assert (device_type.data_type, device_type.access, device_type.default) == (
+        DataType.UNSIGNED32,
+        Access.RO,
+        0x00020192,
+    )
     assert od.object(0x1018).kind is ObjectKind.RECORD
     assert od[0x1018, 1].parent_name == "Identity" and od[0x1018, 1].name == "Vendor-ID"
     assert od[0x1001, 0].pdo_mappable and not od[0x1000, 0].pdo_mappable
@@ -54,7 +62,12 @@ def test_compact_array_expands_with_names_limits_and_inherited_props(od) -> None
     assert [gains.subs[i].name for i in (1, 2, 3)] == ["Gains1", "Middle gain", "Gains3"]
     middle = gains.subs[2]
     assert (middle.low, middle.high, middle.default, middle.access) == (-100, 100, 5, Access.RW)
-    assert (middle.unit, middle.scale, middle.save_type, middle.enum) == ("mA", 0.5, SaveType.DRIVEPAR, {-5: "Minus five"})
+    assert (middle.unit, middle.scale, middle.save_type, middle.enum) == (
+        "mA",
+        0.5,
+        SaveType.DRIVEPAR,
+        {-5: "Minus five"},
+    )
     assert middle.description == "The middle one" and gains.subs[1].description == ""
 
 
@@ -64,7 +77,12 @@ def test_bits_and_other_props(od) -> None:
     assert status.bits[1].extract(0x0300) == 3 and status.bits[1].mask == 0x0300
     speed = od[0x2100, 0]
     assert (speed.group, speed.unit, speed.save_type, speed.reference, speed.is_pointer) == (
-        "Motor", "rpm", SaveType.USER_PAR, "L42", False)
+        "Motor",
+        "rpm",
+        SaveType.USER_PAR,
+        "L42",
+        False,
+    )
     assert od[0x1000, 0].save_type is SaveType.NONE and od[0x1000, 0].group == ""
 
 
@@ -79,9 +97,17 @@ def test_nodeid_defaults_resolve_per_node(mini_od, node_id: int) -> None:
 
 @pytest.mark.parametrize(
     ("query", "key"),
-    [("0x6041", (0x6041, 0)), ("6041", (0x6041, 0)), ("0x1018,2", (0x1018, 2)), ("1018:0x2", (0x1018, 2)),
-     ("0x1018sub2", (0x1018, 2)), ("0x2000subA", None), ("Statusword", (0x6041, 0)), ("middle GAIN", (0x2000, 2)),
-     ("Identity.Product code", (0x1018, 2))],
+    [
+        ("0x6041", (0x6041, 0)),
+        ("6041", (0x6041, 0)),
+        ("0x1018,2", (0x1018, 2)),
+        ("1018:0x2", (0x1018, 2)),
+        ("0x1018sub2", (0x1018, 2)),
+        ("0x2000subA", None),
+        ("Statusword", (0x6041, 0)),
+        ("middle GAIN", (0x2000, 2)),
+        ("Identity.Product code", (0x1018, 2)),
+    ],
 )
 def test_find_by_address_or_name(od, query: str, key) -> None:
     if key is None:

@@ -74,16 +74,19 @@ def _link(name: str, target: str) -> zipfile.ZipInfo:
     return info
 
 
-@pytest.mark.parametrize(("members", "message"), [
-    ([("/etc/evil/project.toml", _project_file())], "absolute path"),
-    ([("evil/project.toml", _project_file()), ("evil/../../outside.txt", b"x")], "path traversal"),
-    ([("evil/project.toml", _project_file()), ("evil\\..\\x.txt", b"x")], "backslash"),
-    ([("C:/evil/project.toml", _project_file())], "absolute path"),
-    ([("evil/project.toml", _project_file()), (_link("evil/X", "/etc"), b"/etc")], "symbolic link"),
-    ([("evil/project.toml", _project_file()), ("other/project.toml", _project_file())], "one top-level"),
-    ([("evil/readme.txt", b"no project file")], "not a project archive"),
-    ([], "empty"),
-])
+@pytest.mark.parametrize(
+    ("members", "message"),
+    [
+        ([("/etc/evil/project.toml", _project_file())], "absolute path"),
+        ([("evil/project.toml", _project_file()), ("evil/../../outside.txt", b"x")], "path traversal"),
+        ([("evil/project.toml", _project_file()), ("evil\\..\\x.txt", b"x")], "backslash"),
+        ([("C:/evil/project.toml", _project_file())], "absolute path"),
+        ([("evil/project.toml", _project_file()), (_link("evil/X", "/etc"), b"/etc")], "symbolic link"),
+        ([("evil/project.toml", _project_file()), ("other/project.toml", _project_file())], "one top-level"),
+        ([("evil/readme.txt", b"no project file")], "not a project archive"),
+        ([], "empty"),
+    ],
+)
 def test_unsafe_or_foreign_archives_are_refused(service: ProjectService, tmp_path: Path, members, message):
     archive = _zip(tmp_path / "evil.zip", members)
     with pytest.raises(ArchiveError, match=message):
@@ -97,8 +100,7 @@ def _assert_untouched(service: ProjectService, tmp_path: Path) -> None:
 
 
 def test_oversized_member_is_refused(service: ProjectService, tmp_path: Path):
-    archive = _zip(tmp_path / "big.zip", [("evil/project.toml", _project_file()),
-                                          ("evil/X/DRIVEPAR.TXT", b"0" * 5000)])
+    archive = _zip(tmp_path / "big.zip", [("evil/project.toml", _project_file()), ("evil/X/DRIVEPAR.TXT", b"0" * 5000)])
     with pytest.raises(ArchiveError, match="more than the limit of 4096"):
         service.unarchive(archive, limits=ArchiveLimits(max_member_bytes=4096))
     _assert_untouched(service, tmp_path)
@@ -106,8 +108,9 @@ def test_oversized_member_is_refused(service: ProjectService, tmp_path: Path):
 
 def test_zip_bomb_is_refused_by_its_compression_ratio(service: ProjectService, tmp_path: Path):
     """10 MB of zeros deflate to ~10 kB: within the size limits, but no project file compresses 1000:1."""
-    archive = _zip(tmp_path / "bomb.zip", [("evil/project.toml", _project_file()),
-                                           ("evil/X/DRIVEPAR.TXT", b"\0" * 10_000_000)])
+    archive = _zip(
+        tmp_path / "bomb.zip", [("evil/project.toml", _project_file()), ("evil/X/DRIVEPAR.TXT", b"\0" * 10_000_000)]
+    )
     with pytest.raises(ArchiveError, match="zip bomb"):
         service.unarchive(archive)
     _assert_untouched(service, tmp_path)
@@ -115,13 +118,14 @@ def test_zip_bomb_is_refused_by_its_compression_ratio(service: ProjectService, t
 
 def test_member_lying_about_its_size_is_refused(service: ProjectService, tmp_path: Path):
     """A header claiming 10 bytes for 1 MB of data: reading stops at the claimed size and the CRC gives it away."""
-    archive = _zip(tmp_path / "liar.zip", [("evil/project.toml", _project_file()),
-                                           ("evil/X/DRIVEPAR.TXT", b"\0" * 1_000_000)])
+    archive = _zip(
+        tmp_path / "liar.zip", [("evil/project.toml", _project_file()), ("evil/X/DRIVEPAR.TXT", b"\0" * 1_000_000)]
+    )
     data = bytearray(archive.read_bytes())
     with zipfile.ZipFile(archive) as reader:
         info = reader.getinfo("evil/X/DRIVEPAR.TXT")
     for offset in (info.header_offset + 22, _central_offset(data, b"evil/X/DRIVEPAR.TXT") + 24):
-        data[offset:offset + 4] = (10).to_bytes(4, "little")        # uncompressed size field
+        data[offset : offset + 4] = (10).to_bytes(4, "little")  # uncompressed size field
     archive.write_bytes(bytes(data))
     with pytest.raises(ArchiveError, match="damaged"):
         service.unarchive(archive)
@@ -130,7 +134,8 @@ def test_member_lying_about_its_size_is_refused(service: ProjectService, tmp_pat
 
 def test_many_members_beyond_the_total_limit_are_refused(service: ProjectService, tmp_path: Path):
     members = [("evil/project.toml", _project_file())] + [
-        (f"evil/X/file{number}.txt", bytes(range(256)) * 20) for number in range(20)]
+        (f"evil/X/file{number}.txt", bytes(range(256)) * 20) for number in range(20)
+    ]
     archive = _zip(tmp_path / "many.zip", members)
     with pytest.raises(ArchiveError, match="add up to 102435 bytes"):
         service.unarchive(archive, limits=ArchiveLimits(max_total_bytes=50_000))
@@ -148,26 +153,36 @@ def _central_offset(data: bytearray, name: bytes) -> int:
     """Offset of the central-directory record of ``name`` (signature PK\\x01\\x02)."""
     position = data.rfind(b"PK\x01\x02")
     while position != -1:
-        if data[position + 46:position + 46 + len(name)] == name:
+        if data[position + 46 : position + 46 + len(name)] == name:
             return position
         position = data.rfind(b"PK\x01\x02", 0, position)
     raise AssertionError("central directory record not found")
 
 
 def _project_with_axis_files(drivepar: bytes, sequence: bytes) -> list[tuple[str, bytes]]:
-    project = (b'[project]\nformat = 1\nname = "bad"\n\n[bus.sim]\ninterface = "sim"\n\n'
-               b'[axis.X]\ndevice = "xtrapulspac"\nnode_id = 1\nbus = "sim"\n')
-    return [("bad/project.toml", project), ("bad/X/DRIVEPAR.TXT", drivepar), ("bad/X/SEQUENCE.TXT", sequence),
-            ("bad/X/USER_PAR.TXT", b"")]
+    project = (
+        b'[project]\nformat = 1\nname = "bad"\n\n[bus.sim]\ninterface = "sim"\n\n'
+        b'[axis.X]\ndevice = "xtrapulspac"\nnode_id = 1\nbus = "sim"\n'
+    )
+    return [
+        ("bad/project.toml", project),
+        ("bad/X/DRIVEPAR.TXT", drivepar),
+        ("bad/X/SEQUENCE.TXT", sequence),
+        ("bad/X/USER_PAR.TXT", b""),
+    ]
 
 
-@pytest.mark.parametrize(("drivepar", "sequence", "message"), [
-    (b"0x3051,0=1\n0x2004,0=12\n", b"", r"bad/X/DRIVEPAR.TXT:2: 0x2004,0 .* expected text"),
-    (b"0x3051,0=1\n0x3051,0=2\n", b"", r"bad/X/DRIVEPAR.TXT:2: duplicate assignment"),
-    (b"", b"; sequences\ngarbage\n", r"bad/X/SEQUENCE.TXT:2: expected 'Key_word = value'"),
-])
-def test_archives_with_broken_axis_files_are_refused(service: ProjectService, tmp_path: Path,
-                                                     drivepar: bytes, sequence: bytes, message: str):
+@pytest.mark.parametrize(
+    ("drivepar", "sequence", "message"),
+    [
+        (b"0x3051,0=1\n0x2004,0=12\n", b"", r"bad/X/DRIVEPAR.TXT:2: 0x2004,0 .* expected text"),
+        (b"0x3051,0=1\n0x3051,0=2\n", b"", r"bad/X/DRIVEPAR.TXT:2: duplicate assignment"),
+        (b"", b"; sequences\ngarbage\n", r"bad/X/SEQUENCE.TXT:2: expected 'Key_word = value'"),
+    ],
+)
+def test_archives_with_broken_axis_files_are_refused(
+    service: ProjectService, tmp_path: Path, drivepar: bytes, sequence: bytes, message: str
+):
     archive = _zip(tmp_path / "bad.zip", _project_with_axis_files(drivepar, sequence))
     with pytest.raises(ArchiveError, match=message):
         service.unarchive(archive)

@@ -17,8 +17,12 @@ from servostudio.services.projects import Axis, Bus, ProjectService
 
 
 def run(store: Path, *args: str) -> subprocess.CompletedProcess:
-    return subprocess.run([sys.executable, "-m", "servostudio", "project", "--projects", str(store), *args],
-                          capture_output=True, text=True, timeout=60)
+    return subprocess.run(
+        [sys.executable, "-m", "servostudio", "project", "--projects", str(store), *args],
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
 
 
 def ok(store: Path, *args: str):

@@ -30,11 +30,22 @@ def test_every_action(cli, tmp_path: Path):
     shown = cli("show", "p")
     assert [b["bitrate"] for b in shown["buses"]] == [None, 250000]
     edited = cli("axis-edit", "p", "X", "--new-name", "Lift", "--node", "5", "--bus", "can", "--description", "z")
-    assert edited["axes"] == [{"name": "Lift", "device": "xtrapulspac", "node_id": 5, "bus": "can",
-                               "description": "z", "motor": "", "application": ""}]
+    assert edited["axes"] == [
+        {
+            "name": "Lift",
+            "device": "xtrapulspac",
+            "node_id": 5,
+            "bus": "can",
+            "description": "z",
+            "motor": "",
+            "application": "",
+        }
+    ]
     cli("set", "p", "Lift", "0x3051=2", "60F9,2=100")
     assert [row["name"] for row in cli("params", "p", "Lift", "--only-set")["parameters"]] == [
-        "0x3051,0 Digital inputs polarity", cli("get", "p", "Lift", "60F9,2")["name"]]
+        "0x3051,0 Digital inputs polarity",
+        cli("get", "p", "Lift", "60F9,2")["name"],
+    ]
     assert cli("params", "p", "Lift", "--only-differences", "--group", "Servo Loops")["parameters"][0]["value"] == 100
     assert len(cli("params", "p", "Lift", "--all")["parameters"]) > len(cli("params", "p", "Lift")["parameters"])
     assert cli("reset", "p", "Lift", "0x3051")["parameters"][0]["file"] is None
@@ -65,7 +76,13 @@ def test_motor_and_template_selection(cli, tmp_path: Path):
     assert {(row["index"], row["value"]) for row in selected["changed"]} == {(0x6410, 2000), (0x6080, 2000)}
     applied = cli("template-apply", "p", "X", "stepper-emulation")
     assert applied["project"]["axes"][0] == {
-        "name": "X", "device": "xtrapulspac", "node_id": 1, "bus": "sim", "description": "", "motor": "TEST-M",
-        "application": "stepper-emulation"}
+        "name": "X",
+        "device": "xtrapulspac",
+        "node_id": 1,
+        "bus": "sim",
+        "description": "",
+        "motor": "TEST-M",
+        "application": "stepper-emulation",
+    }
     assert cli("motor-remove", "TEST-M") == {"removed": "TEST-M"}
     assert cli("motor-list") == []

@@ -10,7 +10,7 @@ from pathlib import Path
 from servostudio.od import builtin_library
 from servostudio.services.projects import Axis, ConflictError, ProjectService
 
-COUNTER = "0x3051"        # Digital inputs polarity, U16 rw, saved in DRIVEPAR.TXT
+COUNTER = "0x3051"  # Digital inputs polarity, U16 rw, saved in DRIVEPAR.TXT
 
 
 def _increment(root: Path, times: int) -> int:
@@ -74,10 +74,17 @@ for _ in range(int(sys.argv[2])):
 def test_processes_never_lose_an_update(sim_project: ProjectService):
     _prepare(sim_project)
     root = sim_project.store.root
-    workers = [subprocess.Popen([sys.executable, "-c", _WORKER, str(root), "20", COUNTER], text=True,
-                                stdin=subprocess.PIPE, stdout=subprocess.PIPE) for _ in range(2)]
+    workers = [
+        subprocess.Popen(
+            [sys.executable, "-c", _WORKER, str(root), "20", COUNTER],
+            text=True,
+            stdin=subprocess.PIPE,
+            stdout=subprocess.PIPE,
+        )
+        for _ in range(2)
+    ]
     assert [worker.stdout.readline() for worker in workers] == ["ready\n", "ready\n"]
-    for worker in workers:           # both are loaded: start them together so their edits interleave
+    for worker in workers:  # both are loaded: start them together so their edits interleave
         worker.stdin.write("go\n")
         worker.stdin.close()
     assert [worker.wait(timeout=90) for worker in workers] == [0, 0]
@@ -103,5 +110,6 @@ def test_blind_writes_from_threads_all_land(sim_project: ProjectService):
         thread.join()
     rows, _ = sim_project.parameters.rows("p", "X", only_set=True)
     assert {(row.variable.subindex, row.value) for row in rows if row.variable.index == 0x3050} == {
-        (number, 0x60FD0000 + number) for number in range(1, 11)}
+        (number, 0x60FD0000 + number) for number in range(1, 11)
+    }
     assert sim_project.store.open("p").project.description.startswith("written by input ")

@@ -18,10 +18,16 @@ def test_demo_project_opens_and_is_valid():
     project = service.store.open("demo").project
     assert [(bus.name, bus.interface) for bus in project.buses] == [("sim", "sim")]
     assert [(axis.name, axis.device, axis.node_id, axis.bus) for axis in project.axes] == [
-        ("X", "xtrapulspac", 1, "sim"), ("Y", "xtrapulspac", 2, "sim"), ("Z", "xtrapulspac", 3, "sim")]
+        ("X", "xtrapulspac", 1, "sim"),
+        ("Y", "xtrapulspac", 2, "sim"),
+        ("Z", "xtrapulspac", 3, "sim"),
+    ]
     simulated = parse_node_list(parse_bus_spec("sim").channel)
-    assert [(node.node_id, node.device) for node in simulated] == [(1, "xtrapulspac"), (2, "xtrapulspac"),
-                                                                   (3, "xtrapulspac")]
+    assert [(node.node_id, node.device) for node in simulated] == [
+        (1, "xtrapulspac"),
+        (2, "xtrapulspac"),
+        (3, "xtrapulspac"),
+    ]
     for axis in project.axes:
         rows, _ = service.parameters.rows("demo", axis.name, only_set=True)
         assert rows == []

@@ -26,9 +26,21 @@ TEST_MOTOR = Motor(
     reference="TEST-MOTOR-1",
     description="made-up motor for the tests",
     source="test data",
-    motor_data={"manufacturer": "Test", "model": "T1", "motor_type": 0, "max_speed": 4500, "rated_speed": 3000,
-                "stall_current": 2500, "peak_current": 7500, "torque_constant": 620, "inertia": 18,
-                "inductance": 85, "pole_pairs": 4, "phase_order": 0x5555, "sensor_offset": 1200},
+    motor_data={
+        "manufacturer": "Test",
+        "model": "T1",
+        "motor_type": 0,
+        "max_speed": 4500,
+        "rated_speed": 3000,
+        "stall_current": 2500,
+        "peak_current": 7500,
+        "torque_constant": 620,
+        "inertia": 18,
+        "inductance": 85,
+        "pole_pairs": 4,
+        "phase_order": 0x5555,
+        "sensor_offset": 1200,
+    },
     objects={(0x3324, 1): -1, (0x3324, 2): 2400},
 )
 
@@ -43,7 +55,7 @@ def test_added_motor_is_listed_and_stored_as_text(catalog: MotorCatalog):
     [motor] = catalog.motors()
     assert motor == TEST_MOTOR
     text = (catalog.user_dir / "TEST-MOTOR-1.toml").read_text()
-    assert "[motor_data]\nmanufacturer = \"Test\"\nmodel = \"T1\"\nmotor_type = 0\nmax_speed = 4500\n" in text
+    assert '[motor_data]\nmanufacturer = "Test"\nmodel = "T1"\nmotor_type = 0\nmax_speed = 4500\n' in text
     assert '"0x3324,1" = -1' in text
     assert motor_from_text(motor_to_text(motor), "x") == TEST_MOTOR
 
@@ -112,12 +124,15 @@ def test_other_devices_refuse_catalog_motors(catalog: MotorCatalog, sim_project:
         sim_project.select_motor("p", "E", "TEST-MOTOR-1")
 
 
-@pytest.mark.parametrize(("stall", "peak", "drive_max", "drive_rated", "expected"), [
-    (2500, 7500, 0, 0, (2500, 3000)),
-    (2500, 7500, 6000, 2000, (2000, 3000)),
-    (2500, 100_000, 0, 0, (2500, 32767)),
-    (0, 7500, 0, 0, (0, 0)),
-])
+@pytest.mark.parametrize(
+    ("stall", "peak", "drive_max", "drive_rated", "expected"),
+    [
+        (2500, 7500, 0, 0, (2500, 3000)),
+        (2500, 7500, 6000, 2000, (2000, 3000)),
+        (2500, 100_000, 0, 0, (2500, 32767)),
+        (0, 7500, 0, 0, (0, 0)),
+    ],
+)
 def test_current_limit_rule_matches_the_simulated_drive(stall, peak, drive_max, drive_rated, expected):
     assert current_limits(stall, peak, drive_max, drive_rated) == expected
 

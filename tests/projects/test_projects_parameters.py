@@ -10,7 +10,13 @@ from hypothesis import strategies as st
 
 from servostudio.od import Access, DataType, SaveType, Variable
 from servostudio.services.projects import Axis, FileFormatError, ParameterRefused, ProjectService
-from servostudio.services.projects.values import BadValue, from_file_value, normalize, parse_text, to_file_value
+from servostudio.services.projects.parameter_values import (
+    BadValue,
+    from_file_value,
+    normalize,
+    parse_text,
+    to_file_value,
+)
 
 
 @pytest.fixture
@@ -27,7 +33,10 @@ def _files(service: ProjectService) -> dict[str, bytes]:
 def test_values_go_to_the_file_their_save_type_names(axis: ProjectService):
     change = axis.parameters.set("p", "X", {"0x6060": "Sequence", "0x1006": 20000, "0x2004": "Lift axis"})
     assert [(row.variable.index, row.value, row.file) for row in change.rows] == [
-        (0x6060, -3, "DRIVEPAR.TXT"), (0x1006, 20000, "USER_PAR.TXT"), (0x2004, "Lift axis", "DRIVEPAR.TXT")]
+        (0x6060, -3, "DRIVEPAR.TXT"),
+        (0x1006, 20000, "USER_PAR.TXT"),
+        (0x2004, "Lift axis", "DRIVEPAR.TXT"),
+    ]
     files = _files(axis)
     assert files["DRIVEPAR.TXT"] == b"0x2004,0=Lift axis\n0x6060,0=-3\n"
     assert files["USER_PAR.TXT"] == b"0x1006,0=20000\n"
@@ -48,16 +57,19 @@ def test_node_id_defaults_are_resolved_for_the_axis(axis: ProjectService):
     assert row.default == 0x80 + 4
 
 
-@pytest.mark.parametrize(("changes", "message"), [
-    ({"0x6410,14": 25}, r"0x6410,14 .*25 is outside 1\.\.24"),
-    ({"0x6041": 0}, r"0x6041,0 .* is read-only \(ro\)"),
-    ({"0x6040": 6}, r"0x6040,0 .* not saved in a drive file .* only be written to a live drive"),
-    ({"0x7777": 1}, r"no object named '0x7777'"),
-    ({"0x6060": "fast"}, r"'fast' is not a decimal or 0x hex integer or one of: Profile position"),
-    ({"0x6060": 1.5}, r"INTEGER8 needs an integer"),
-    ({"0x3051": 1, "0x6060": 200}, r"0x6060,0 .*200 is outside -128\.\.127"),
-    ({"0x2004": "1st axis"}, r"DRIVEPAR.TXT: text value of 0x2004,0 starts like a number"),
-])
+@pytest.mark.parametrize(
+    ("changes", "message"),
+    [
+        ({"0x6410,14": 25}, r"0x6410,14 .*25 is outside 1\.\.24"),
+        ({"0x6041": 0}, r"0x6041,0 .* is read-only \(ro\)"),
+        ({"0x6040": 6}, r"0x6040,0 .* not saved in a drive file .* only be written to a live drive"),
+        ({"0x7777": 1}, r"no object named '0x7777'"),
+        ({"0x6060": "fast"}, r"'fast' is not a decimal or 0x hex integer or one of: Profile position"),
+        ({"0x6060": 1.5}, r"INTEGER8 needs an integer"),
+        ({"0x3051": 1, "0x6060": 200}, r"0x6060,0 .*200 is outside -128\.\.127"),
+        ({"0x2004": "1st axis"}, r"DRIVEPAR.TXT: text value of 0x2004,0 starts like a number"),
+    ],
+)
 def test_refused_writes_explain_and_write_nothing(axis: ProjectService, changes, message):
     axis.parameters.set("p", "X", {"0x3051": 7})
     before = _files(axis)
@@ -114,8 +126,9 @@ def test_compare_lists_exactly_the_changed_objects(axis: ProjectService):
     digital, _ = axis.parameters.compare("p", "X", group=io_group.upper(), only_differences=True)
     assert [(row.variable.index, row.variable.subindex) for row in digital] == [(0x3050, 2), (0x3051, 0)]
     everything, _ = axis.parameters.compare("p", "X")
-    assert len(everything) == sum(1 for v in axis.library.load("xtrapulspac").variables()
-                                  if v.save_type is not SaveType.NONE)
+    assert len(everything) == sum(
+        1 for v in axis.library.load("xtrapulspac").variables() if v.save_type is not SaveType.NONE
+    )
 
 
 def test_compare_takes_a_drive_column(axis: ProjectService):
@@ -157,8 +170,9 @@ def test_real64_values_survive_the_object_file(value):
 @settings(deadline=None)  # no per-example time limit: the machine is shared
 @given(st.text())
 def test_user_text_parses_or_is_refused_with_the_object_name(text):
-    variable = Variable(0x6060, 0, "Modes of operation", DataType.INTEGER8, Access.RW,
-                        enum={1: "Profile position", -3: "Sequence"})
+    variable = Variable(
+        0x6060, 0, "Modes of operation", DataType.INTEGER8, Access.RW, enum={1: "Profile position", -3: "Sequence"}
+    )
     try:
         value = parse_text(variable, text)
     except BadValue as error:

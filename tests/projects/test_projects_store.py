@@ -42,20 +42,26 @@ def test_axes_get_a_directory_with_the_drive_files(sim_project: ProjectService):
     project = store.open("p").project
     assert [(a.name, a.device, a.node_id) for a in project.axes] == [("X", "xtrapulspac", 1), ("Y", "cd1k", 100)]
     assert sorted(p.name for p in (store.root / "p" / "X").iterdir()) == [
-        "DRIVEPAR.TXT", "SEQUENCE.TXT", "USER_PAR.TXT"]
+        "DRIVEPAR.TXT",
+        "SEQUENCE.TXT",
+        "USER_PAR.TXT",
+    ]
     assert sorted(p.name for p in (store.root / "p" / "Y").iterdir()) == ["DRIVEPAR.TXT"]
 
 
-@pytest.mark.parametrize(("axis", "message"), [
-    (Axis("X", "xtrapulspac", 64, "sim"), "node ID 64 is out of range 1-63"),
-    (Axis("X", "xtrapulspac", 0, "sim"), "out of range 1-63"),
-    (Axis("X", "cd1k", 128, "sim"), "out of range 1-127"),
-    (Axis("X", "xtrapulspac", 1, "nobus"), "unknown bus 'nobus'"),
-    (Axis("X", "nodevice", 1, "sim"), "unknown device 'nodevice'"),
-    (Axis("A", "xtrapulspac", 5, "sim"), "node ID 5 on bus 'sim' is already used by axis 'first'"),
-    (Axis("FIRST", "cd1k", 6, "sim"), "used twice"),
-    (Axis("B", "cd1k", 69, "sim"), "node ID 69 on bus 'sim' is reserved by axis 'first'"),
-])
+@pytest.mark.parametrize(
+    ("axis", "message"),
+    [
+        (Axis("X", "xtrapulspac", 64, "sim"), "node ID 64 is out of range 1-63"),
+        (Axis("X", "xtrapulspac", 0, "sim"), "out of range 1-63"),
+        (Axis("X", "cd1k", 128, "sim"), "out of range 1-127"),
+        (Axis("X", "xtrapulspac", 1, "nobus"), "unknown bus 'nobus'"),
+        (Axis("X", "nodevice", 1, "sim"), "unknown device 'nodevice'"),
+        (Axis("A", "xtrapulspac", 5, "sim"), "node ID 5 on bus 'sim' is already used by axis 'first'"),
+        (Axis("FIRST", "cd1k", 6, "sim"), "used twice"),
+        (Axis("B", "cd1k", 69, "sim"), "node ID 69 on bus 'sim' is reserved by axis 'first'"),
+    ],
+)
 def test_axis_rules_refuse_and_write_nothing(sim_project: ProjectService, axis: Axis, message: str):
     store = sim_project.store
     store.add_axis("p", Axis("first", "xtrapulspac", 5, "sim"))
@@ -157,9 +163,13 @@ def test_one_change_is_a_one_line_diff(sim_project: ProjectService):
     changed = {path for path in after if after[path] != before[path]}
     assert changed == {"p/project.toml", "p/Y/DRIVEPAR.TXT"}
     for path in changed:
-        diff = [line for line in difflib.unified_diff(before[path].decode().splitlines(),
-                                                      after[path].decode().splitlines(), lineterm="", n=0)
-                if line[:1] in "+-" and not line.startswith(("+++", "---"))]
+        diff = [
+            line
+            for line in difflib.unified_diff(
+                before[path].decode().splitlines(), after[path].decode().splitlines(), lineterm="", n=0
+            )
+            if line[:1] in "+-" and not line.startswith(("+++", "---"))
+        ]
         assert len(diff) == 2, diff
 
 

@@ -37,7 +37,8 @@ def test_a_template_sets_mode_and_io_and_is_recorded(axis: ProjectService, key: 
     assert row.value == mode
     template = next(t for t in TEMPLATES if t.key == key)
     assert [(r.variable.index, r.variable.subindex, r.value) for r in choice.change.rows] == [
-        (s.index, s.sub, s.value) for s in template.settings]
+        (s.index, s.sub, s.value) for s in template.settings
+    ]
     assert choice.snapshot.project.axis("X").application == key
     assert axis.application("p", "X") == template
 
@@ -65,10 +66,14 @@ def test_dcf_holds_commissioning_and_project_values_and_passes_dcfchk(axis: Proj
     dcf.optionxform = str
     dcf.read(path, encoding="latin-1")
     assert dict(dcf["DeviceComissioning"]) == {
-        "NodeID": "3", "NodeName": "X", "Baudrate": "1000", "NetNumber": "1", "NetworkName": "p",
-        "CANopenManager": "0"}
-    values = {section: dcf[section]["ParameterValue"] for section in dcf.sections()
-              if "ParameterValue" in dcf[section]}
+        "NodeID": "3",
+        "NodeName": "X",
+        "Baudrate": "1000",
+        "NetNumber": "1",
+        "NetworkName": "p",
+        "CANopenManager": "0",
+    }
+    values = {section: dcf[section]["ParameterValue"] for section in dcf.sections() if "ParameterValue" in dcf[section]}
     assert values == {"6060": "-3", "3050sub1": "0x60FD0003", "2004": "Lift axis", "1006": "0x4E20"}
 
 

@@ -78,16 +78,19 @@ def test_what_the_parser_accepts_tomllib_reads_identically(tables, data):
         assert {key: node[key] for key in table.values} == table.values
 
 
-@pytest.mark.parametrize(("text", "line", "reason"), [
-    ('[project]\nname = "x\n', 2, "not closed"),
-    ("[project]\nname = 'x'\n", 2, "not a quoted string"),
-    ('[project]\nname = "a"\nname = "b"\n', 3, "set twice"),
-    ("[project]\n[project]\n", 2, "defined twice"),
-    ('name = "x"\n', 1, "outside any [table]"),
-    ("[project]\nnode = 007\n", 2, "not a quoted string, a decimal integer"),
-    ("[project\n", 1, "expected ']'"),
-    ('[a]\nb = 1\n[a.b]\n', 3, "clashes with key"),
-])
+@pytest.mark.parametrize(
+    ("text", "line", "reason"),
+    [
+        ('[project]\nname = "x\n', 2, "not closed"),
+        ("[project]\nname = 'x'\n", 2, "not a quoted string"),
+        ('[project]\nname = "a"\nname = "b"\n', 3, "set twice"),
+        ("[project]\n[project]\n", 2, "defined twice"),
+        ('name = "x"\n', 1, "outside any [table]"),
+        ("[project]\nnode = 007\n", 2, "not a quoted string, a decimal integer"),
+        ("[project\n", 1, "expected ']'"),
+        ("[a]\nb = 1\n[a.b]\n", 3, "clashes with key"),
+    ],
+)
 def test_errors_name_the_line_and_the_reason(text, line, reason):
     with pytest.raises(FileFormatError) as caught:
         tomlsubset.parse(text, "bad.toml")
@@ -98,10 +101,23 @@ def test_errors_name_the_line_and_the_reason(text, line, reason):
 
 NAMES = st.from_regex(r"[A-Za-z0-9][A-Za-z0-9 _.+-]{0,20}[A-Za-z0-9_+-]", fullmatch=True)
 BUSES = st.builds(Bus, NAMES, st.text(min_size=1, max_size=20), st.none() | st.integers(1, 10**7))
-AXES = st.builds(Axis, NAMES, st.sampled_from(["xtrapulspac", "cd1k"]), st.integers(1, 127), NAMES,
-                 st.text(max_size=30), st.text(max_size=10), st.text(max_size=10))
-PROJECTS = st.builds(Project, NAMES, st.text(max_size=40), st.lists(BUSES, max_size=3, unique_by=lambda b: b.name)
-                     .map(tuple), st.lists(AXES, max_size=4, unique_by=lambda a: a.name).map(tuple))
+AXES = st.builds(
+    Axis,
+    NAMES,
+    st.sampled_from(["xtrapulspac", "cd1k"]),
+    st.integers(1, 127),
+    NAMES,
+    st.text(max_size=30),
+    st.text(max_size=10),
+    st.text(max_size=10),
+)
+PROJECTS = st.builds(
+    Project,
+    NAMES,
+    st.text(max_size=40),
+    st.lists(BUSES, max_size=3, unique_by=lambda b: b.name).map(tuple),
+    st.lists(AXES, max_size=4, unique_by=lambda a: a.name).map(tuple),
+)
 
 
 @settings(max_examples=60, deadline=None)

@@ -46,7 +46,8 @@ def test_compare_shows_exactly_the_object_changed_on_the_drive_and_take_stores_i
     drive_of(live, "X").write("0x6083", 131072)
     assert differing(live, "X") == [("0x6083,0", {"drive": 131072, "project": 65536, "default": 65536})]
     assert differing(live, "X", group="Profile Position Mode") == [
-        ("0x6083,0", {"drive": 131072, "project": 65536, "default": 65536})]
+        ("0x6083,0", {"drive": 131072, "project": 65536, "default": 65536})
+    ]
     assert differing(live, "X", group="Motor") == []
     change = live.take("p", "X", ["0x6083"])
     assert [(row.variable.key, row.value, row.file) for row in change.rows] == [((0x6083, 0), 131072, "DRIVEPAR.TXT")]
@@ -61,7 +62,9 @@ def test_take_without_addresses_takes_every_difference(commissioned, live, servi
     change = live.take("p", "Y")
     assert sorted((row.variable.key, row.value) for row in change.rows) == [((0x3055, 0), 3), ((0x6084, 0), 1000)]
     assert [(row.variable.key, row.file) for row in service.parameters.rows("p", "Y", only_set=True)[0]] == [
-        ((0x3055, 0), "DRIVEPAR.TXT"), ((0x6084, 0), "DRIVEPAR.TXT")]
+        ((0x3055, 0), "DRIVEPAR.TXT"),
+        ((0x6084, 0), "DRIVEPAR.TXT"),
+    ]
 
 
 def test_writing_to_the_drive_checks_the_whole_selection_before_sending(commissioned, live):
@@ -72,13 +75,21 @@ def test_writing_to_the_drive_checks_the_whole_selection_before_sending(commissi
         live.write("p", "X", ["0x6081", "0x6065"])
     assert drive.read("0x6081").raw == 1  # nothing was sent
     report = live.write("p", "X", ["0x6081"]).as_dict()
-    assert report["ok"] and report["objects"] == [{"address": "0x6081,0", "name": "0x6081,0 Profile velocity",
-                                                   "value": 8192, "status": "written", "error": None,
-                                                   "drive": 8192}]
+    assert report["ok"] and report["objects"] == [
+        {
+            "address": "0x6081,0",
+            "name": "0x6081,0 Profile velocity",
+            "value": 8192,
+            "status": "written",
+            "error": None,
+            "drive": 8192,
+        }
+    ]
     assert drive.read("0x6081").raw == 8192
     everything = live.write("p", "X")  # without addresses: every object that differs
     assert [(item.variable.key, item.status, item.read_back) for item in everything.writes] == [
-        ((0x3051, 0), "written", 5)]
+        ((0x3051, 0), "written", 5)
+    ]
     assert drive.read("0x3051").raw == 5
 
 
@@ -105,9 +116,21 @@ def test_an_upload_into_a_project_changed_meanwhile_is_refused(commissioned, liv
 
 
 def test_selecting_a_motor_on_the_drive_reads_back_what_the_drive_derived(commissioned, live, service):
-    service.motors.add(Motor("M1", "test motor", "values chosen for the test", {
-        "manufacturer": "ACME", "max_speed": 3000, "stall_current": 2500, "peak_current": 7500, "pole_pairs": 4,
-        "inductance": 55}))
+    service.motors.add(
+        Motor(
+            "M1",
+            "test motor",
+            "values chosen for the test",
+            {
+                "manufacturer": "ACME",
+                "max_speed": 3000,
+                "stall_current": 2500,
+                "peak_current": 7500,
+                "pole_pairs": 4,
+                "inductance": 55,
+            },
+        )
+    )
     drive = drive_of(live, "Y")
     choice = live.select_motor("p", "Y", "M1")
     on_drive = {key: drive.read(key).raw for key in ("0x6410,9", "0x6080", "0x340F", "0x3410,1", "0x6075", "0x6073")}

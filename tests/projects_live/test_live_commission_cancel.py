@@ -23,6 +23,7 @@ def _cancel_at_first_step(operation: str):
     def progress(event):
         if event.get("operation") == operation and event.get("done", 0) > 0:
             cancel.cancel()
+
     return cancel, progress
 
 
@@ -34,8 +35,9 @@ def test_cancelled_download_reports_what_was_written_and_stores_nothing(project,
     (first,) = axis.files  # the files after the cancelled one were not started
     assert first["file"] == "DRIVEPAR.TXT" and first["cancelled"] is True and first["stored"] == ""
     assert first["counts"].get("not written", 0) > 0
-    assert f"{first['counts'].get('written', 0)} of {sum(first['counts'].values())} objects were written" \
-        in first["error"]
+    assert (
+        f"{first['counts'].get('written', 0)} of {sum(first['counts'].values())} objects were written" in first["error"]
+    )
 
 
 def test_cancelled_upload_leaves_the_project_unchanged(project, live, service):

@@ -9,8 +9,8 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from servostudio.drive.object_values import ObjectValue
 from servostudio.drive.sdo import SdoAbortError, SdoTimeoutError
-from servostudio.drive.values import ObjectValue
 from servostudio.od import builtin_library
 from servostudio.services.projects import Bus, Project
 from servostudio.services.projects.live.scaninto import bus_name_for
@@ -51,8 +51,9 @@ def variables(*keys):
 
 
 def test_values_refusals_and_undecodable_answers_are_kept_apart():
-    drive = ScriptedDrive({(0x6083, 0): 5, (0x2004, 0): "axis\0\0", (0x6060, 0): ("abort", 0x06020000),
-                           (0x6084, 0): "undecodable"})
+    drive = ScriptedDrive(
+        {(0x6083, 0): 5, (0x2004, 0): "axis\0\0", (0x6060, 0): ("abort", 0x06020000), (0x6084, 0): "undecodable"}
+    )
     source = DriveValues(drive, variables((0x6083, 0), (0x2004, 0), (0x6060, 0), (0x6084, 0)))
     assert drive.requested == [(0x6083, 0), (0x2004, 0), (0x6060, 0), (0x6084, 0)]
     assert [source.read(*key) for key in drive.requested] == [5, "axis", None, None]

@@ -18,7 +18,6 @@ from servostudio.transport.rs232_framing import DRIVE_HEADER, HOST_HEADER, Frame
 _channels = itertools.count()
 
 
-
 @pytest.fixture(autouse=True, scope="module")
 def short_switch_interval():
     """The simulated drives, the bus reader and the socket threads share one interpreter here: a short GIL switch
@@ -186,8 +185,9 @@ def sim_network(tmp_path_factory):
     """
     from servostudio.sim.network import SimulatedNetwork
 
-    network = SimulatedNetwork("1,2,3", state_dir=tmp_path_factory.mktemp("sim-flash"),
-                               sdo_response_time=FAST_SDO_RESPONSE)
+    network = SimulatedNetwork(
+        "1,2,3", state_dir=tmp_path_factory.mktemp("sim-flash"), sdo_response_time=FAST_SDO_RESPONSE
+    )
     network.start()
     yield network
     network.stop()
@@ -243,8 +243,9 @@ def _commission(drive) -> None:
     changes nothing there; empty names get a text so that a backup holds every object (the object file cannot
     carry an empty text, and a backup leaves such objects out).
     """
-    variables = [var for kind in (FileKind.DRIVEPAR, FileKind.USER_PAR)
-                 for var in backup_objects(drive, kind.save_type)]
+    variables = [
+        var for kind in (FileKind.DRIVEPAR, FileKind.USER_PAR) for var in backup_objects(drive, kind.save_type)
+    ]
     reads = [(var, drive.submit_read(var)) for var in variables]
     for var, future in reads:
         value = future.result().raw
@@ -252,7 +253,6 @@ def _commission(drive) -> None:
             drive.write(var, var.minimum)
         elif isinstance(value, str) and not value.strip("\0 "):
             drive.write(var, f"node{drive.node}")
-
 
 
 @pytest.fixture(scope="session")

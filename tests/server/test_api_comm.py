@@ -51,8 +51,9 @@ def test_read_write_and_refusals(client):
 def test_state_and_faults(client):
     with client.websocket_connect("/api/ws/events?types=job") as socket:
         motion_client = {"X-Servo-Client": socket.receive_json()["client"]}
-        enabled = client.put("/api/buses/socketcand/nodes/2/state", json={"target": "operation-enabled"},
-                             headers=motion_client).json()
+        enabled = client.put(
+            "/api/buses/socketcand/nodes/2/state", json={"target": "operation-enabled"}, headers=motion_client
+        ).json()
         assert enabled["state"] == "OPERATION ENABLED"
         disabled = client.put("/api/buses/socketcand/nodes/2/state", json={"target": "switch-on-disabled"}).json()
         assert disabled["state"] == "SWITCH ON DISABLED"
@@ -65,19 +66,27 @@ def test_file_download_and_corrupted_upload(client):
     assert text.startswith("; USER_PAR.TXT of node 3")
     lines = text.splitlines()
     lines[3] = lines[3].split("=")[0] + "=not-a-number"
-    answer = client.put("/api/buses/socketcand/nodes/3/files/USER_PAR.TXT", content="\n".join(lines),
-                        headers={"content-type": "text/plain"})
+    answer = client.put(
+        "/api/buses/socketcand/nodes/3/files/USER_PAR.TXT",
+        content="\n".join(lines),
+        headers={"content-type": "text/plain"},
+    )
     assert answer.status_code == 422
     assert "USER_PAR.TXT:4:" in answer.json()["detail"]
-    good = client.put("/api/buses/socketcand/nodes/3/files/USER_PAR.TXT?store=false", content=text,
-                      headers={"content-type": "text/plain"}).json()
+    good = client.put(
+        "/api/buses/socketcand/nodes/3/files/USER_PAR.TXT?store=false",
+        content=text,
+        headers={"content-type": "text/plain"},
+    ).json()
     assert good["ok"] is True
 
 
 def test_backup_job_with_progress_events(client, tmp_path):
     with client.websocket_connect("/api/ws/events?types=progress,job") as socket:
-        job = client.post("/api/buses/socketcand/backup", json={"directory": str(tmp_path), "nodes": [1, 2],
-                                                          "files": ["USER_PAR.TXT"]}).json()
+        job = client.post(
+            "/api/buses/socketcand/backup",
+            json={"directory": str(tmp_path), "nodes": [1, 2], "files": ["USER_PAR.TXT"]},
+        ).json()
         assert job["state"] == "running"
         seen = []
         while True:
@@ -133,8 +142,11 @@ def test_real_http_through_uvicorn(socketcand, tmp_path):
 def test_enabling_needs_a_live_client_and_its_axes_stop_when_it_goes(client):
     refused = client.put("/api/buses/socketcand/nodes/3/state", json={"target": "operation-enabled"})
     assert refused.status_code == 409 and "live client" in refused.json()["detail"]
-    forged = client.put("/api/buses/socketcand/nodes/3/state", json={"target": "operation-enabled"},
-                        headers={"X-Servo-Client": "not-a-connected-client"})
+    forged = client.put(
+        "/api/buses/socketcand/nodes/3/state",
+        json={"target": "operation-enabled"},
+        headers={"X-Servo-Client": "not-a-connected-client"},
+    )
     assert forged.status_code == 409
     raw_enable = client.put("/api/buses/socketcand/nodes/3/objects/controlword", json={"value": 0x0F})
     assert raw_enable.status_code == 409 and "live client" in raw_enable.json()["detail"]
@@ -147,8 +159,11 @@ def test_enabling_needs_a_live_client_and_its_axes_stop_when_it_goes(client):
     with client.websocket_connect("/api/ws/events?types=job") as socket:
         hello = socket.receive_json()
         assert hello["type"] == "hello"
-        enabled = client.put("/api/buses/socketcand/nodes/3/state", json={"target": "operation-enabled"},
-                             headers={"X-Servo-Client": hello["client"]}).json()
+        enabled = client.put(
+            "/api/buses/socketcand/nodes/3/state",
+            json={"target": "operation-enabled"},
+            headers={"X-Servo-Client": hello["client"]},
+        ).json()
         assert enabled["state"] == "OPERATION ENABLED"
     # The client went away: the server quick-stops the axis it enabled.
     deadline = time.monotonic() + 10

@@ -49,14 +49,19 @@ class _HoldAtFirstStep:
     def __call__(self, event: dict) -> None:
         if event.get("type") == "job":
             self.job_events.append(event)
-        if (event.get("type") == "progress" and event.get("operation") == self.operation
-                and event.get("done", 0) > 0 and not self.reached.is_set()):
+        if (
+            event.get("type") == "progress"
+            and event.get("operation") == self.operation
+            and event.get("done", 0) > 0
+            and not self.reached.is_set()
+        ):
             self.reached.set()
             self.released.wait(WAIT)
 
 
-def _cancel_at_first_step(app, client: TestClient, operation: str, url: str,
-                          body: dict) -> tuple[dict, dict, _HoldAtFirstStep]:
+def _cancel_at_first_step(
+    app, client: TestClient, operation: str, url: str, body: dict
+) -> tuple[dict, dict, _HoldAtFirstStep]:
     """Start a job, cancel it while its first progress step holds the bus reader, let it finish.
     Answers (job as started, job as finished, the listener with the job events)."""
     hub = app.state.connections.events
@@ -77,16 +82,21 @@ def _cancel_at_first_step(app, client: TestClient, operation: str, url: str,
 def _changed_file(app, client: TestClient, directory: Path) -> dict[tuple[int, int], tuple[int, int]]:
     """Back up node 1's DRIVEPAR.TXT, then rewrite it with every plain integer value raised by one.
     Answers {(index, sub): (value on the drive, value in the file)}."""
-    job = client.post("/api/buses/sim/backup", json={"directory": str(directory), "nodes": [1],
-                                                      "files": ["DRIVEPAR.TXT"]}).json()
+    job = client.post(
+        "/api/buses/sim/backup", json={"directory": str(directory), "nodes": [1], "files": ["DRIVEPAR.TXT"]}
+    ).json()
     assert _finish(client, job["id"])["state"] == "done"
     path = directory / "node1" / "DRIVEPAR.TXT"
     drive = app.state.connections.get("sim").drive(1)
     changed = {}
     for entry in read_object_file(path):
         variable = drive.variable((entry.index, entry.sub))
-        if isinstance(entry.value, int) and not variable.enum and variable.high is not None \
-                and entry.value + 1 <= variable.high:
+        if (
+            isinstance(entry.value, int)
+            and not variable.enum
+            and variable.high is not None
+            and entry.value + 1 <= variable.high
+        ):
             changed[(entry.index, entry.sub)] = (entry.value, entry.value + 1)
     write_object_file(path, [ObjectEntry(index, sub, new) for (index, sub), (_, new) in changed.items()])
     assert len(changed) > 10
@@ -96,8 +106,13 @@ def _changed_file(app, client: TestClient, directory: Path) -> dict[tuple[int, i
 def test_cancelled_restore_reports_exactly_what_was_written(app_client, tmp_path):
     app, client = app_client
     changed = _changed_file(app, client, tmp_path)
-    job, finished, hold = _cancel_at_first_step(app, client, "restore", "/api/buses/sim/restore", {
-        "directory": str(tmp_path), "nodes": [1], "files": ["DRIVEPAR.TXT"], "store": False})
+    job, finished, hold = _cancel_at_first_step(
+        app,
+        client,
+        "restore",
+        "/api/buses/sim/restore",
+        {"directory": str(tmp_path), "nodes": [1], "files": ["DRIVEPAR.TXT"], "store": False},
+    )
     assert finished["state"] == "cancelled"
     (result,) = finished["result"]["1"]
     assert result["cancelled"] is True and result["ok"] is False and result["stored"] == ""
@@ -117,8 +132,9 @@ def test_cancelled_restore_reports_exactly_what_was_written(app_client, tmp_path
 
 def test_cancelled_backup_leaves_no_file(app_client, tmp_path):
     app, client = app_client
-    _, finished, _ = _cancel_at_first_step(app, client, "backup", "/api/buses/sim/backup",
-                                           {"directory": str(tmp_path), "nodes": [1, 2]})
+    _, finished, _ = _cancel_at_first_step(
+        app, client, "backup", "/api/buses/sim/backup", {"directory": str(tmp_path), "nodes": [1, 2]}
+    )
     assert finished["state"] == "cancelled"
     assert finished["result"] == {"1": [], "2": []}  # no file was complete when the cancel came
     assert [path for path in tmp_path.rglob("*") if path.is_file()] == []
@@ -127,8 +143,9 @@ def test_cancelled_backup_leaves_no_file(app_client, tmp_path):
 def test_cancel_of_unknown_or_finished_job(app_client, tmp_path):
     _, client = app_client
     assert client.post("/api/jobs/job999999/cancel").status_code == 404
-    job = client.post("/api/buses/sim/backup", json={"directory": str(tmp_path), "nodes": [3],
-                                                      "files": ["DRIVEPAR.TXT"]}).json()
+    job = client.post(
+        "/api/buses/sim/backup", json={"directory": str(tmp_path), "nodes": [3], "files": ["DRIVEPAR.TXT"]}
+    ).json()
     done = _finish(client, job["id"])
     assert done["state"] == "done"
     assert client.post(f"/api/jobs/{job['id']}/cancel").json()["state"] == "done"
@@ -139,8 +156,11 @@ def test_file_upload_as_a_job(app_client, tmp_path):
     app, client = app_client
     changed = _changed_file(app, client, tmp_path)
     text = (tmp_path / "node1" / "DRIVEPAR.TXT").read_text(encoding="latin-1")
-    started = client.put("/api/buses/sim/nodes/1/files/DRIVEPAR.TXT?job=true&store=false", content=text,
-                         headers={"Content-Type": "text/plain"})
+    started = client.put(
+        "/api/buses/sim/nodes/1/files/DRIVEPAR.TXT?job=true&store=false",
+        content=text,
+        headers={"Content-Type": "text/plain"},
+    )
     assert started.status_code == 202 and started.json()["operation"] == "restore"
     finished = _finish(client, started.json()["id"])
     assert finished["state"] == "done"
@@ -149,7 +169,10 @@ def test_file_upload_as_a_job(app_client, tmp_path):
     drive = app.state.connections.get("sim").drive(1)
     assert all(drive.read(key).raw == new for key, (_, new) in changed.items())
 
-    broken = client.put("/api/buses/sim/nodes/1/files/DRIVEPAR.TXT?job=true", content="0x6081,0=oops\n",
-                        headers={"Content-Type": "text/plain"})
+    broken = client.put(
+        "/api/buses/sim/nodes/1/files/DRIVEPAR.TXT?job=true",
+        content="0x6081,0=oops\n",
+        headers={"Content-Type": "text/plain"},
+    )
     failed = _finish(client, broken.json()["id"])
     assert failed["state"] == "failed" and ":1:" in failed["error"] and "nothing was written" in failed["error"]

@@ -3,7 +3,8 @@
 from __future__ import annotations
 
 import pytest
-from hypothesis import given, strategies as st
+from hypothesis import given
+from hypothesis import strategies as st
 
 from servostudio.transport.spec import SERIAL_BAUDRATES, BusSpec, BusSpecError, parse_bus_spec
 
@@ -17,14 +18,20 @@ from servostudio.transport.spec import SERIAL_BAUDRATES, BusSpec, BusSpecError, 
         ("ixxat:0@500k", {"interface": "ixxat", "channel": 0, "bitrate": 500000}),
         ("kvaser:0", {"interface": "kvaser", "channel": 0}),
         ("slcan:/dev/ttyACM0@1M", {"interface": "slcan", "channel": "/dev/ttyACM0", "bitrate": 1000000}),
-        ("socketcand:127.0.0.1:29536", {"interface": "socketcand", "host": "127.0.0.1", "port": 29536,
-                                        "channel": "can0"}),
-        ("socketcand:localhost:29536/vcan1", {"interface": "socketcand", "host": "localhost", "port": 29536,
-                                              "channel": "vcan1"}),
+        (
+            "socketcand:127.0.0.1:29536",
+            {"interface": "socketcand", "host": "127.0.0.1", "port": 29536, "channel": "can0"},
+        ),
+        (
+            "socketcand:localhost:29536/vcan1",
+            {"interface": "socketcand", "host": "localhost", "port": 29536, "channel": "vcan1"},
+        ),
         ("virtual:bench", {"interface": "virtual", "channel": "bench"}),
         ("serial:/dev/ttyUSB0", {"interface": "servostudio_rs232", "channel": "/dev/ttyUSB0", "baudrate": 19200}),
-        ("serial:socket://127.0.0.1:29600@115200",
-         {"interface": "servostudio_rs232", "channel": "socket://127.0.0.1:29600", "baudrate": 115200}),
+        (
+            "serial:socket://127.0.0.1:29600@115200",
+            {"interface": "servostudio_rs232", "channel": "socket://127.0.0.1:29600", "baudrate": 115200},
+        ),
     ],
 )
 def test_documented_forms(text, config):
@@ -65,22 +72,39 @@ def test_errors_name_the_problem(text, words):
     assert repr(text.strip()) in str(error.value)
 
 
-names = st.text(st.characters(whitelist_categories=("Lu", "Ll", "Nd"), whitelist_characters="_-./"),
-                min_size=1, max_size=20)
+names = st.text(
+    st.characters(whitelist_categories=("Lu", "Ll", "Nd"), whitelist_characters="_-./"), min_size=1, max_size=20
+)
 specs = st.one_of(
     st.builds(BusSpec, kind=st.just("socketcan"), channel=names),
-    st.builds(BusSpec, kind=st.sampled_from(["pcan", "slcan"]), channel=names,
-              bitrate=st.none() | st.integers(1, 10_000_000)),
-    st.builds(BusSpec, kind=st.sampled_from(["ixxat", "kvaser"]), channel=st.integers(0, 99).map(str),
-              bitrate=st.none() | st.integers(1, 10_000_000)),
-    st.builds(BusSpec, kind=st.just("socketcand"), host=names.filter(lambda name: "/" not in name),
-              port=st.integers(1, 65535),
-              channel=names.filter(lambda name: "/" not in name)),
+    st.builds(
+        BusSpec, kind=st.sampled_from(["pcan", "slcan"]), channel=names, bitrate=st.none() | st.integers(1, 10_000_000)
+    ),
+    st.builds(
+        BusSpec,
+        kind=st.sampled_from(["ixxat", "kvaser"]),
+        channel=st.integers(0, 99).map(str),
+        bitrate=st.none() | st.integers(1, 10_000_000),
+    ),
+    st.builds(
+        BusSpec,
+        kind=st.just("socketcand"),
+        host=names.filter(lambda name: "/" not in name),
+        port=st.integers(1, 65535),
+        channel=names.filter(lambda name: "/" not in name),
+    ),
     st.builds(BusSpec, kind=st.just("virtual"), channel=names),
-    st.builds(BusSpec, kind=st.just("serial"), channel=names.map(lambda name: "socket://" + name + ":1"),
-              bitrate=st.none() | st.sampled_from(SERIAL_BAUDRATES)),
-    st.builds(BusSpec, kind=st.just("sim"),
-              channel=st.lists(st.integers(1, 127), min_size=1, max_size=8).map(lambda ns: ",".join(map(str, ns)))),
+    st.builds(
+        BusSpec,
+        kind=st.just("serial"),
+        channel=names.map(lambda name: "socket://" + name + ":1"),
+        bitrate=st.none() | st.sampled_from(SERIAL_BAUDRATES),
+    ),
+    st.builds(
+        BusSpec,
+        kind=st.just("sim"),
+        channel=st.lists(st.integers(1, 127), min_size=1, max_size=8).map(lambda ns: ",".join(map(str, ns))),
+    ),
 )
 
 

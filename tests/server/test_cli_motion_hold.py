@@ -22,8 +22,17 @@ def _state(spec: str, node: int) -> str:
 
 
 def test_enable_holds_until_interrupted_then_quick_stops(socketcand):
-    command = [sys.executable, "-m", "servostudio", "state", "--bus", socketcand.spec, "--node", "2",
-               "operation-enabled"]
+    command = [
+        sys.executable,
+        "-m",
+        "servostudio",
+        "state",
+        "--bus",
+        socketcand.spec,
+        "--node",
+        "2",
+        "operation-enabled",
+    ]
     process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     try:
         line = process.stderr.readline()
@@ -40,5 +49,9 @@ def test_enable_holds_until_interrupted_then_quick_stops(socketcand):
     while _state(socketcand.spec, 2) == "OPERATION ENABLED" and time.monotonic() < deadline:
         time.sleep(0.1)
     assert _state(socketcand.spec, 2) in ("QUICK STOP ACTIVE", "SWITCH ON DISABLED")
-    subprocess.run([sys.executable, "-m", "servostudio", "state", "--bus", socketcand.spec, "--node", "2",
-                    "switch-on-disabled"], check=True, capture_output=True, timeout=30)
+    subprocess.run(
+        [sys.executable, "-m", "servostudio", "state", "--bus", socketcand.spec, "--node", "2", "switch-on-disabled"],
+        check=True,
+        capture_output=True,
+        timeout=30,
+    )

@@ -28,7 +28,12 @@ def commissioned_bus(socketcand, commission):
 def test_cli_round_trip(commissioned_bus, tmp_path):
     executable = Path(sys.executable).with_name("servostudio")
     environment = {**os.environ, "SERVOSTUDIO": str(executable), "PATH": f"{executable.parent}:{os.environ['PATH']}"}
-    result = subprocess.run(["bash", str(SCRIPT), commissioned_bus, str(tmp_path)], capture_output=True, text=True,
-                            env=environment, timeout=180)
+    result = subprocess.run(
+        ["bash", str(SCRIPT), commissioned_bus, str(tmp_path)],
+        capture_output=True,
+        text=True,
+        env=environment,
+        timeout=180,
+    )
     assert result.returncode == 0, f"{result.stdout}\n{result.stderr}"
     assert "cli round trip ok" in result.stdout

@@ -3,24 +3,33 @@
 from __future__ import annotations
 
 import pytest
-from hypothesis import given, strategies as st
+from hypothesis import given
+from hypothesis import strategies as st
 
 from servostudio.drive.cia402 import Command, State, apply_command, decode_state, next_command
 from servostudio.drive.faults import cia402_error_text, faults_from_words
 from servostudio.drive.monitor import decode_emergency
 from servostudio.drive.nmt import NmtCommand
+from servostudio.drive.object_values import ObjectValue, ValueInputError, decode_raw, parse_input
 from servostudio.drive.profiles import profile_for, signature_value
-from servostudio.drive.values import ObjectValue, ValueInputError, decode_raw, parse_input
 from servostudio.od.datatypes import DataType, encode
 from servostudio.od.model import Access, BitField, Variable
 
 
-@pytest.mark.parametrize("statusword, state", [
-    (0x0240, State.SWITCH_ON_DISABLED), (0x0221, State.READY_TO_SWITCH_ON), (0x0223, State.SWITCHED_ON),
-    (0x0227, State.OPERATION_ENABLED), (0x0207, State.QUICK_STOP_ACTIVE), (0x0208, State.FAULT),
-    (0x020F, State.FAULT_REACTION_ACTIVE), (0x0200, State.NOT_READY_TO_SWITCH_ON),
-    (0x8227, State.OPERATION_ENABLED),  # busy bit and warnings do not change the state
-])
+@pytest.mark.parametrize(
+    "statusword, state",
+    [
+        (0x0240, State.SWITCH_ON_DISABLED),
+        (0x0221, State.READY_TO_SWITCH_ON),
+        (0x0223, State.SWITCHED_ON),
+        (0x0227, State.OPERATION_ENABLED),
+        (0x0207, State.QUICK_STOP_ACTIVE),
+        (0x0208, State.FAULT),
+        (0x020F, State.FAULT_REACTION_ACTIVE),
+        (0x0200, State.NOT_READY_TO_SWITCH_ON),
+        (0x8227, State.OPERATION_ENABLED),  # busy bit and warnings do not change the state
+    ],
+)
 def test_manual_status_words_decode(statusword, state):
     assert decode_state(statusword) is state
 
@@ -46,8 +55,13 @@ def _simulate_path(start: State, target: State) -> list[Command]:
     return commands
 
 
-reachable = [State.SWITCH_ON_DISABLED, State.READY_TO_SWITCH_ON, State.SWITCHED_ON, State.OPERATION_ENABLED,
-             State.QUICK_STOP_ACTIVE]
+reachable = [
+    State.SWITCH_ON_DISABLED,
+    State.READY_TO_SWITCH_ON,
+    State.SWITCHED_ON,
+    State.OPERATION_ENABLED,
+    State.QUICK_STOP_ACTIVE,
+]
 
 
 @given(st.sampled_from(reachable + [State.FAULT]), st.sampled_from(reachable))
@@ -57,7 +71,10 @@ def test_every_reachable_target_is_reached(start, target):
 
 def test_enable_sequence_of_the_manual():
     assert _simulate_path(State.SWITCH_ON_DISABLED, State.OPERATION_ENABLED) == [
-        Command.SHUTDOWN, Command.SWITCH_ON, Command.ENABLE_OPERATION]
+        Command.SHUTDOWN,
+        Command.SWITCH_ON,
+        Command.ENABLE_OPERATION,
+    ]
     assert apply_command(0x0070, Command.ENABLE_OPERATION) == 0x007F  # mode bits 4-6 kept
 
 
@@ -114,8 +131,9 @@ def test_wider_answer_is_accepted_but_garbage_is_not():
 
 
 def test_bits_and_enumeration_text():
-    variable = _variable(DataType.UNSIGNED16, bits=(BitField(3, 3, "Fault"), BitField(8, 9, "Pair")),
-                         enum={0x0308: "special"})
+    variable = _variable(
+        DataType.UNSIGNED16, bits=(BitField(3, 3, "Fault"), BitField(8, 9, "Pair")), enum={0x0308: "special"}
+    )
     value = ObjectValue(1, variable, 0x0308)
     assert value.text == "special"
     assert [(bit["name"], bit["value"]) for bit in value.bits()] == [("Fault", 1), ("Pair", 3)]
@@ -124,8 +142,10 @@ def test_bits_and_enumeration_text():
 def test_xtrapulspac_error_words_and_emcy():
     profile = profile_for("xtrapulspac")
     faults = faults_from_words(dict(profile.errors), [(0x4, 1), (0x4, 33)])
-    assert [(fault.code, fault.name) for fault in faults] == [(3, "Undervoltage (temporized)"),
-                                                              (35, "Position following error")]
+    assert [(fault.code, fault.name) for fault in faults] == [
+        (3, "Undervoltage (temporized)"),
+        (35, "Position following error"),
+    ]
     assert "0x6065" in faults[1].remedy
     emergency = decode_emergency(4, bytes([0x11, 0x86, 0x81, 35, 0, 0, 0, 0]), profile)
     assert emergency.cia402_code == 0x8611 and emergency.error_register == 0x81

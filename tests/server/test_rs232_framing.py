@@ -3,7 +3,8 @@
 from __future__ import annotations
 
 import pytest
-from hypothesis import assume, given, strategies as st
+from hypothesis import assume, given
+from hypothesis import strategies as st
 
 from servostudio.transport.rs232_framing import (
     DRIVE_HEADER,
@@ -83,7 +84,7 @@ def test_arbitrary_garbage_never_breaks_the_decoder(header, items, garbage):
     out = decoder.feed(b"".join(tail) + b"".join(tail))
     expected = [(cob, data.ljust(8, b"\0")) for cob, data in items]
     # Everything of the second copy arrives, whatever the garbage did to the first.
-    assert out[len(out) - len(expected):] == expected
+    assert out[len(out) - len(expected) :] == expected
 
 
 @given(headers, cob_ids, payloads, cob_ids, payloads, st.integers(1, FRAME_LENGTH - 1), st.integers(1, 255))

@@ -32,8 +32,11 @@ def test_downloads_reach_the_slave(engine, slaves):
 
 
 def test_many_transfers_to_several_nodes_complete_in_order(engine, slaves):
-    futures = [(node, value, engine.download(node, 0x2003, 0, value.to_bytes(4, "little")))
-               for value in range(20) for node in (1, 5)]
+    futures = [
+        (node, value, engine.download(node, 0x2003, 0, value.to_bytes(4, "little")))
+        for value in range(20)
+        for node in (1, 5)
+    ]
     for _, _, future in futures:
         future.result(5)
     assert slaves[1].sdo[0x2003].raw == 19 and slaves[5].sdo[0x2003].raw == 19
@@ -45,13 +48,17 @@ def test_abort_names_node_object_and_meaning(engine):
     with pytest.raises(SdoAbortError) as error:
         engine.upload(1, 0x2FFF, 0).result(2)
     assert error.value.code == 0x06020000
-    assert str(error.value) == ("node 1, object 0x2FFF,0: object does not exist in the object dictionary "
-                                "(SDO abort 0x06020000)")
+    assert str(error.value) == (
+        "node 1, object 0x2FFF,0: object does not exist in the object dictionary (SDO abort 0x06020000)"
+    )
 
 
 def test_timeout_names_node_and_object(engine):
-    with pytest.raises(SdoTimeoutError, match=r"node 9, object 0x1000,0: no SDO response within 300 ms on bus test "
-                                              r"\(request sent twice\)"):
+    with pytest.raises(
+        SdoTimeoutError,
+        match=r"node 9, object 0x1000,0: no SDO response within 300 ms on bus test "
+        r"\(request sent twice\)",
+    ):
         engine.upload(9, 0x1000, 0).result(3)
     with pytest.raises(SdoTimeoutError, match=r"node 9, object 0x2003,0: no SDO response within 300 ms on bus test$"):
         engine.download(9, 0x2003, 0, b"\x01").result(3)
@@ -80,8 +87,13 @@ def test_a_read_whose_request_was_lost_is_sent_again(virtual_channel):
                 continue
             requests.append(bytes(message.data))
             if len(requests) > 1:
-                drive_side.send(can.Message(arbitration_id=0x594, is_extended_id=False,
-                                            data=bytes([0x4F]) + bytes(message.data[1:4]) + bytes([42, 0, 0, 0])))
+                drive_side.send(
+                    can.Message(
+                        arbitration_id=0x594,
+                        is_extended_id=False,
+                        data=bytes([0x4F]) + bytes(message.data[1:4]) + bytes([42, 0, 0, 0]),
+                    )
+                )
 
     responder = threading.Thread(target=respond, daemon=True)
     responder.start()
@@ -132,8 +144,12 @@ def test_a_batch_of_reads_gives_every_outcome_in_order(engine):
     """One future for many reads: values in request order, an abort where the object is missing, each reported."""
     objects = [(0x1000, 0), (0x2FFF, 0), (0x2004, 0), (0x2002, 0)]
     reported: list[int] = []
-    batch = engine.upload_all(5, objects, convert=lambda position, data: (position, data),
-                              on_each=lambda position, outcome: reported.append(position))
+    batch = engine.upload_all(
+        5,
+        objects,
+        convert=lambda position, data: (position, data),
+        on_each=lambda position, outcome: reported.append(position),
+    )
     outcomes = batch.future.result(5)
     assert outcomes[0] == (0, (0x00020192).to_bytes(4, "little"))
     assert isinstance(outcomes[1], SdoAbortError) and outcomes[1].code == 0x06020000
@@ -185,8 +201,12 @@ def test_a_drive_that_stops_answering_ends_the_batch_at_the_first_silent_read(en
 
 
 def test_a_batch_of_writes_reaches_the_drive_in_order(engine, slaves):
-    writes = [(0x2003, 0, (1).to_bytes(4, "little")), (0x2FFF, 0, b"\x01"), (0x2004, 0, b"a long new axis name"),
-              (0x2003, 0, (2).to_bytes(4, "little"))]
+    writes = [
+        (0x2003, 0, (1).to_bytes(4, "little")),
+        (0x2FFF, 0, b"\x01"),
+        (0x2004, 0, b"a long new axis name"),
+        (0x2003, 0, (2).to_bytes(4, "little")),
+    ]
     outcomes = engine.download_all(1, writes, convert=lambda position, _: position).future.result(5)
     assert outcomes[0] == 0 and outcomes[2] == 2 and outcomes[3] == 3
     assert isinstance(outcomes[1], SdoAbortError) and outcomes[1].code == 0x06020000

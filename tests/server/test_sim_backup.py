@@ -7,6 +7,7 @@ import time
 
 import pytest
 
+from servostudio.formats.objectfile import read_object_file
 from servostudio.services.backup import (
     BackupError,
     RestoreValidationError,
@@ -14,7 +15,6 @@ from servostudio.services.backup import (
     restore_file,
     run_per_drive,
 )
-from servostudio.formats.objectfile import read_object_file
 from servostudio.services.bus import ConnectionManager
 from servostudio.services.scan import scan
 from servostudio.sim.nmt import NmtState
@@ -34,17 +34,21 @@ def connection(endpoint, commission):
 
 def _cut_at_start(endpoint):
     """A progress callback that cuts the link as soon as the transfers are queued (with slow drives: mid-way)."""
+
     def progress(event):
         if endpoint.server is not None:
             endpoint.cut()
+
     return progress
 
 
 def _cut_after_first_step(endpoint):
     """Cut the link at the first progress step (5 % of the restore confirmed): some objects are written, most not."""
+
     def progress(event):
         if event["done"] > 0 and endpoint.server is not None:
             endpoint.cut()
+
     return progress
 
 
@@ -109,8 +113,7 @@ def test_corrupted_file_is_refused_with_its_line_and_nothing_is_written(connecti
     assert not any(0x601 <= frame.can_id <= 0x67F and frame.data[0] & 0xE0 == 0x20 for frame in frames)
 
 
-def test_link_cut_during_backup_leaves_no_file_and_link_recovers(connection, endpoint, sim_network, slow,
-                                                                   tmp_path):
+def test_link_cut_during_backup_leaves_no_file_and_link_recovers(connection, endpoint, sim_network, slow, tmp_path):
     drive = connection.drive(1)
     path = tmp_path / "DRIVEPAR.TXT"
     with slow(sim_network), pytest.raises(BackupError, match="no file written"):
@@ -143,8 +146,9 @@ def test_link_cut_during_restore_says_what_was_written(connection, endpoint, sim
     assert rerun.ok, rerun.as_dict()
 
 
-def test_a_drive_that_stops_answering_ends_the_restore_at_its_first_silent_write(connection, sim_network, slow,
-                                                                                 tmp_path):
+def test_a_drive_that_stops_answering_ends_the_restore_at_its_first_silent_write(
+    connection, sim_network, slow, tmp_path
+):
     """The bus stays up but node 3 goes silent (NMT stop) early in a restore: one write times out and the rest of
     the file is not sent at all (not one timeout per object); the result says what was written."""
     drive = connection.drive(3)

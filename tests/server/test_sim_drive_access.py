@@ -43,15 +43,31 @@ def test_scan_finds_and_identifies_every_drive(connection):
 def _sample_variable(drive, data_type: DataType):
     """A writable object of this type without side effects on other objects."""
     for var in drive.dictionary.variables():
-        if (var.data_type is data_type and var.access is Access.RW and var.index >= 0x2000
-                and var.index not in (0x6040, 0x6060, 0x3410, 0x6410, 0x2004) and not var.is_pointer
-                and var.minimum is not None and var.maximum is not None and var.maximum > var.minimum):
+        if (
+            var.data_type is data_type
+            and var.access is Access.RW
+            and var.index >= 0x2000
+            and var.index not in (0x6040, 0x6060, 0x3410, 0x6410, 0x2004)
+            and not var.is_pointer
+            and var.minimum is not None
+            and var.maximum is not None
+            and var.maximum > var.minimum
+        ):
             return var
     pytest.skip(f"no plain rw {data_type.name} object in the dictionary")
 
 
-@pytest.mark.parametrize("data_type", [DataType.INTEGER8, DataType.INTEGER16, DataType.INTEGER32,
-                                       DataType.UNSIGNED8, DataType.UNSIGNED16, DataType.UNSIGNED32])
+@pytest.mark.parametrize(
+    "data_type",
+    [
+        DataType.INTEGER8,
+        DataType.INTEGER16,
+        DataType.INTEGER32,
+        DataType.UNSIGNED8,
+        DataType.UNSIGNED16,
+        DataType.UNSIGNED32,
+    ],
+)
 def test_write_and_read_back_every_integer_type(connection, data_type):
     drive = connection.drive(2)
     var = _sample_variable(drive, data_type)

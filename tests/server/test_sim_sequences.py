@@ -9,10 +9,12 @@ from servostudio.services.backup import BackupError, FileKind, RestoreValidation
 from servostudio.services.bus import ConnectionManager
 from servostudio.services.scan import scan
 
-TABLE = SequenceTable({
-    2: Sequence.of(SequenceType.POS, Pos=40960, Speed=1000, Accel=500, Decel=500, Tempo=100, SeqNext=5),
-    5: Sequence.of(SequenceType.SPEED, Speed=-300, AccelTime=50, DecelTime=60, RunTime=2000),
-})
+TABLE = SequenceTable(
+    {
+        2: Sequence.of(SequenceType.POS, Pos=40960, Speed=1000, Accel=500, Decel=500, Tempo=100, SeqNext=5),
+        5: Sequence.of(SequenceType.SPEED, Speed=-300, AccelTime=50, DecelTime=60, RunTime=2000),
+    }
+)
 
 
 @pytest.fixture(scope="module")

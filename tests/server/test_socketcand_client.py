@@ -15,21 +15,40 @@ from servostudio.sim.socketcand import format_frame
 from servostudio.transport.socketcand import SocketcandBus, _parse_frames
 
 frames = st.builds(
-    lambda extended, can_id, data, stamp: (Frame(can_id & (0x1FFFFFFF if extended else 0x7FF), data,
-                                                 extended=extended), stamp),
-    st.booleans(), st.integers(0, 0x1FFFFFFF), st.binary(max_size=8), st.integers(0, 10**9).map(lambda us: us / 1e6))
-noise = st.sampled_from(["< ok >", "< echo >", "< error could not send >", "< frame 12G 1.0 00 >",
-                         "< frame 123 1.0 ABC >", "< frame 123 1.0 000102030405060708 >", "garbage"])
+    lambda extended, can_id, data, stamp: (
+        Frame(can_id & (0x1FFFFFFF if extended else 0x7FF), data, extended=extended),
+        stamp,
+    ),
+    st.booleans(),
+    st.integers(0, 0x1FFFFFFF),
+    st.binary(max_size=8),
+    st.integers(0, 10**9).map(lambda us: us / 1e6),
+)
+noise = st.sampled_from(
+    [
+        "< ok >",
+        "< echo >",
+        "< error could not send >",
+        "< frame 12G 1.0 00 >",
+        "< frame 123 1.0 ABC >",
+        "< frame 123 1.0 000102030405060708 >",
+        "garbage",
+    ]
+)
 
 
 @settings(max_examples=200, deadline=None)
 @given(st.lists(st.one_of(frames, noise), max_size=20))
 def test_every_frame_is_parsed_and_everything_else_skipped(items):
     text = "".join(format_frame(*item) if isinstance(item, tuple) else item for item in items)
-    expected = [(frame.can_id, frame.data, round(stamp, 6), frame.extended)
-                for frame, stamp in (item for item in items if isinstance(item, tuple))]
-    parsed = [(identifier, data, round(stamp, 6), extended) for identifier, data, stamp, extended
-              in _parse_frames(text.encode())]
+    expected = [
+        (frame.can_id, frame.data, round(stamp, 6), frame.extended)
+        for frame, stamp in (item for item in items if isinstance(item, tuple))
+    ]
+    parsed = [
+        (identifier, data, round(stamp, 6), extended)
+        for identifier, data, stamp, extended in _parse_frames(text.encode())
+    ]
     assert parsed == expected
 
 

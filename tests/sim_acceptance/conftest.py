@@ -100,16 +100,30 @@ class Axis:
 
     def wait_status(self, condition: Callable[[int], bool], what: str, timeout: float = WAIT) -> int:
         """Wait until the last received status word satisfies `condition`; fail naming `what` otherwise."""
-        return self._wait_for(lambda: self.status, condition, what, timeout, 0.005,
-                              lambda status: f"last status word 0x{status:04X} ({state_of(status)})")
+        return self._wait_for(
+            lambda: self.status,
+            condition,
+            what,
+            timeout,
+            0.005,
+            lambda status: f"last status word 0x{status:04X} ({state_of(status)})",
+        )
 
     def wait_value(self, index: int, condition: Callable[[int], bool], what: str, timeout: float = WAIT) -> int:
         """Poll an object by SDO until `condition` holds; fail naming `what` and the last value otherwise."""
-        return self._wait_for(lambda: self.read(index), condition, what, timeout, 0.01,
-                              lambda value: f"0x{index:04X} = {value}")
+        return self._wait_for(
+            lambda: self.read(index), condition, what, timeout, 0.01, lambda value: f"0x{index:04X} = {value}"
+        )
 
-    def _wait_for(self, sample: Callable[[], int], condition: Callable[[int], bool], what: str, timeout: float,
-                  period: float, last: Callable[[int], str]) -> int:
+    def _wait_for(
+        self,
+        sample: Callable[[], int],
+        condition: Callable[[int], bool],
+        what: str,
+        timeout: float,
+        period: float,
+        last: Callable[[int], str],
+    ) -> int:
         deadline = time.monotonic() + timeout
         while True:
             value = sample()
@@ -168,7 +182,6 @@ class Axis:
     def set_mode(self, mode: str) -> None:
         self.node.op_mode = mode  # canopen logs (does not raise) a refused switch: check what the drive shows
         assert self.node.op_mode == mode, f"0x6061 shows {self.node.op_mode}, expected {mode}"
-
 
 
 def configure_pdos(node: BaseNode402) -> None:

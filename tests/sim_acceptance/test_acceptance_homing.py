@@ -10,7 +10,6 @@ each motor turn; the axis powers up at 0.
 from __future__ import annotations
 
 import pytest
-
 from tests.sim_acceptance.conftest import REV, Axis
 
 HOME_OFFSET = 12_345

@@ -57,6 +57,7 @@ def test_profile_velocity_reaches_the_target_speed_then_zero(axis: Axis):
     assert axis.read(0x6064) != position  # it really turns
 
     axis.write(0x60FF, 0)
-    axis.wait_status(lambda s: s & STATUS_TARGET_REACHED and s & STATUS_SET_POINT_ACK,
-                     "zero speed reached (SW10 and SW12)")
+    axis.wait_status(
+        lambda s: s & STATUS_TARGET_REACHED and s & STATUS_SET_POINT_ACK, "zero speed reached (SW10 and SW12)"
+    )
     assert abs(axis.read(0x606C)) <= VELOCITY_WINDOW

@@ -78,8 +78,9 @@ def test_quick_stop_that_stays_active_then_disable_voltage_and_back_to_operation
     axis.go("QUICK STOP ACTIVE")  # 11
     axis.wait_status(lambda status: status & STATUS_TARGET_REACHED, "quick stop ended (target reached)")
     entered = axis.first_sample(mark, lambda s: s.state == "QUICK STOP ACTIVE", "quick stop active")
-    ended = axis.first_sample(mark, lambda s: s.state == "QUICK STOP ACTIVE" and s.status & STATUS_TARGET_REACHED,
-                              "quick stop ended")
+    ended = axis.first_sample(
+        mark, lambda s: s.state == "QUICK STOP ACTIVE" and s.status & STATUS_TARGET_REACHED, "quick stop ended"
+    )
     assert abs(ended.position - entered.position) < REV // 4  # the 0x6085 ramp: 0.1 rev from 10 rev/s
     assert coast_after(axis, ended) < REV // 64  # holding
     assert state_of(axis.read(0x6041)) == "QUICK STOP ACTIVE"

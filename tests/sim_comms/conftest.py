@@ -88,8 +88,13 @@ class RawClient:
     def send(self, can_id: int, data: bytes = b"", rtr: bool = False, dlc: int | None = None) -> None:
         import can
 
-        message = can.Message(arbitration_id=can_id, data=None if rtr else data, is_extended_id=False,
-                              is_remote_frame=rtr, dlc=dlc if dlc is not None else len(data))
+        message = can.Message(
+            arbitration_id=can_id,
+            data=None if rtr else data,
+            is_extended_id=False,
+            is_remote_frame=rtr,
+            dlc=dlc if dlc is not None else len(data),
+        )
         self.bus.send(message)
 
     def collect(self, seconds: float = 0.01) -> list:

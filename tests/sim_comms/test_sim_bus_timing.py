@@ -81,7 +81,9 @@ def test_sender_does_not_receive_its_own_frame():
     assert sender.frames == [] and len(other.frames) == 1
 
 
-def test_sdo_response_arrives_after_request_time_plus_response_time_plus_response_time_on_wire(make_network, raw_client):
+def test_sdo_response_arrives_after_request_time_plus_response_time_plus_response_time_on_wire(
+    make_network, raw_client
+):
     network = make_network("1", bitrate=500_000, sdo_response_time=2e-3)
     network.advance(0.01)
     client = raw_client(network)
@@ -89,6 +91,10 @@ def test_sdo_response_arrives_after_request_time_plus_response_time_plus_respons
     request = bytes([0x40, 0x18, 0x10, 1, 0, 0, 0, 0])
     client.send(0x601, request)
     [response] = [m for m in client.collect(0.02) if m.arbitration_id == 0x581]
-    expected = start + frame_bits(Frame(0x601, request)) / 500_000 + 2e-3 + frame_bits(
-        Frame(0x581, bytes(response.data))) / 500_000
+    expected = (
+        start
+        + frame_bits(Frame(0x601, request)) / 500_000
+        + 2e-3
+        + frame_bits(Frame(0x581, bytes(response.data))) / 500_000
+    )
     assert response.timestamp == pytest.approx(expected, abs=1e-9)

@@ -26,9 +26,25 @@ def test_host_port_parsing():
 
 def test_sim_command_serves_socketcand_and_the_serial_link(tmp_path):
     process = subprocess.Popen(
-        [sys.executable, "-m", "servostudio", "sim", "--nodes", "1,2", "--socketcand", "127.0.0.1:0",
-         "--serial-tcp", "127.0.0.1:0", "--bitrate", "500000", "--state-dir", str(tmp_path)],
-        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+        [
+            sys.executable,
+            "-m",
+            "servostudio",
+            "sim",
+            "--nodes",
+            "1,2",
+            "--socketcand",
+            "127.0.0.1:0",
+            "--serial-tcp",
+            "127.0.0.1:0",
+            "--bitrate",
+            "500000",
+            "--state-dir",
+            str(tmp_path),
+        ],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
     )
     try:
         description = json.loads(process.stdout.readline())
@@ -54,7 +70,11 @@ def test_sim_command_serves_socketcand_and_the_serial_link(tmp_path):
 
 
 def test_bad_node_list_is_a_clear_error():
-    result = subprocess.run([sys.executable, "-m", "servostudio", "sim", "--nodes", "1,1", "--socketcand", "127.0.0.1:0"],
-                            capture_output=True, text=True, timeout=60)
+    result = subprocess.run(
+        [sys.executable, "-m", "servostudio", "sim", "--nodes", "1,1", "--socketcand", "127.0.0.1:0"],
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
     assert result.returncode == 3
     assert "node ID 1 appears twice" in result.stderr

@@ -15,7 +15,9 @@ def frames_with_id(messages, can_id):
 
 def write(client, node_id, index, sub, value, size=4):
     command = {1: 0x2F, 2: 0x2B, 4: 0x23}[size]
-    response = client.sdo(node_id, bytes([command]) + struct.pack("<HB", index, sub) + value.to_bytes(size, "little", signed=value < 0))
+    response = client.sdo(
+        node_id, bytes([command]) + struct.pack("<HB", index, sub) + value.to_bytes(size, "little", signed=value < 0)
+    )
     assert response[0] == 0x60, response.hex()
 
 
@@ -44,7 +46,8 @@ def test_heartbeat_period_and_nmt_states(client):
     beats = frames_with_id(client.collect(0.35), 0x701)
     assert [bytes(b.data) for b in beats] == [b"\x7f"] * 3
     assert [later.timestamp - earlier.timestamp for earlier, later in zip(beats, beats[1:])] == pytest.approx(
-        [0.1, 0.1], abs=1e-3)
+        [0.1, 0.1], abs=1e-3
+    )
     for command, state in ((0x01, 0x05), (0x02, 0x04), (0x80, 0x7F), (0x01, 0x05)):
         client.send(0x000, bytes([command, 0]))
         beats = frames_with_id(client.collect(0.1), 0x701)

@@ -16,8 +16,12 @@ from servostudio.sim.network import NodeSpec, parse_node_list
 from servostudio.sim.socketcand import format_frame, parse_send
 
 devices = st.sampled_from(["xtrapulspac", "cd1k", "encotrive"])
-node_specs = st.lists(st.tuples(st.integers(1, 127), st.one_of(st.none(), devices)), min_size=1, max_size=10,
-                      unique_by=lambda spec: spec[0])
+node_specs = st.lists(
+    st.tuples(st.integers(1, 127), st.one_of(st.none(), devices)),
+    min_size=1,
+    max_size=10,
+    unique_by=lambda spec: spec[0],
+)
 
 
 @given(node_specs)
@@ -28,8 +32,14 @@ def test_node_list_round_trip(specs):
 
 @pytest.mark.parametrize(
     ("text", "reason"),
-    [("", "empty entry"), ("1,,2", "empty entry"), ("x", "not a node ID"), ("0", "outside 1..127"),
-     ("128", "outside 1..127"), ("3,3:cd1k", "appears twice")],
+    [
+        ("", "empty entry"),
+        ("1,,2", "empty entry"),
+        ("x", "not a node ID"),
+        ("0", "outside 1..127"),
+        ("128", "outside 1..127"),
+        ("3,3:cd1k", "appears twice"),
+    ],
 )
 def test_bad_node_lists_name_the_reason(text, reason):
     with pytest.raises(ValueError, match=reason):
@@ -38,7 +48,9 @@ def test_bad_node_lists_name_the_reason(text, reason):
 
 frames = st.builds(
     lambda extended, can_id, data: Frame(can_id & (0x1FFFFFFF if extended else 0x7FF), data, extended=extended),
-    st.booleans(), st.integers(0, 0x1FFFFFFF), st.binary(max_size=8),
+    st.booleans(),
+    st.integers(0, 0x1FFFFFFF),
+    st.binary(max_size=8),
 )
 
 
@@ -54,7 +66,10 @@ def test_what_python_can_sends_is_parsed_back(frame):
 def test_what_the_server_sends_is_read_by_python_can(frame, timestamp):
     message = convert_ascii_message_to_can_message(format_frame(frame, timestamp))
     assert (message.arbitration_id, bytes(message.data), message.is_extended_id) == (
-        frame.can_id, frame.data, frame.extended)
+        frame.can_id,
+        frame.data,
+        frame.extended,
+    )
     assert message.timestamp == pytest.approx(timestamp, abs=1e-6)
 
 

@@ -83,12 +83,22 @@ def test_cia402_state_machine_with_basenode402(bus):
 def test_save_to_flash_writes_drivepar(bus):
     client, network, state_dir = bus
     node = remote(client, 1)
-    saved = next(var for var in network.node(1).store.od.variables()
-                 if var.save_type.value == "DRIVEPAR" and var.access.writable and var.data_type.is_integer
-                 and var.minimum is not None and var.maximum is not None and var.maximum > var.minimum)
+    saved = next(
+        var
+        for var in network.node(1).store.od.variables()
+        if var.save_type.value == "DRIVEPAR"
+        and var.access.writable
+        and var.data_type.is_integer
+        and var.minimum is not None
+        and var.maximum is not None
+        and var.maximum > var.minimum
+    )
     value = saved.minimum + 1
-    node.sdo.download(saved.index, saved.subindex, saved.data_type.size and value.to_bytes(
-        saved.data_type.size, "little", signed=saved.data_type.is_signed))
+    node.sdo.download(
+        saved.index,
+        saved.subindex,
+        saved.data_type.size and value.to_bytes(saved.data_type.size, "little", signed=saved.data_type.is_signed),
+    )
     node.sdo[0x1010][1].raw = SAVE
     deadline = time.monotonic() + 10
     while node.sdo[0x1010][1].raw != 5 and time.monotonic() < deadline:

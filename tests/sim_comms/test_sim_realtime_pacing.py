@@ -33,7 +33,7 @@ class RecordingLock:
         self.spans: list[float] = []
         self._held_from: list[float] = []
 
-    def __enter__(self) -> "RecordingLock":
+    def __enter__(self) -> RecordingLock:
         self._lock.acquire()
         self._held_from.append(self._clock.now)
         return self
@@ -88,8 +88,9 @@ def test_a_client_frame_enters_the_bus_at_the_simulations_present_while_it_lags(
         slow_network.inject(Frame(0x100 + number, bytes([number])))
     time.sleep(0.05)
     slow_network.stop()
-    delivered = {frame.can_id - 0x100: timestamp for frame, timestamp in recorder.frames
-                 if 0x100 <= frame.can_id < 0x100 + 30}
+    delivered = {
+        frame.can_id - 0x100: timestamp for frame, timestamp in recorder.frames if 0x100 <= frame.can_id < 0x100 + 30
+    }
     assert sorted(delivered) == list(range(30))
     # one chunk (250 µs) plus arbitration and the frame itself (≈ 0.1 ms): never a whole catch-up burst
     assert max(delivered[number] - sent_at[number] for number in range(30)) < 1e-3

@@ -189,8 +189,9 @@ def test_arbitrary_requests_get_well_formed_answers(test_dictionary, requests):
 
     from .conftest import RawClient, counting_factory
 
-    network = SimulatedNetwork("1", device="testdrive", dictionaries={"testdrive": test_dictionary},
-                               behaviour_factory=counting_factory)
+    network = SimulatedNetwork(
+        "1", device="testdrive", dictionaries={"testdrive": test_dictionary}, behaviour_factory=counting_factory
+    )
     client = RawClient(network)
     try:
         client.collect(0.001)

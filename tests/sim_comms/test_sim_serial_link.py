@@ -38,10 +38,9 @@ def line(make_network):
     network.start()
     wait_for_boot(network)
     gateway = SerialGateway(network)
-    with SerialTcpServer(gateway) as server:
-        with socket.create_connection(server.address) as connection:
-            connection.settimeout(0.2)
-            yield network, gateway, connection
+    with SerialTcpServer(gateway) as server, socket.create_connection(server.address) as connection:
+        connection.settimeout(0.2)
+        yield network, gateway, connection
     gateway.close()
 
 

@@ -25,8 +25,9 @@ EDS = str(DATA / "testdrive.eds")
 
 @pytest.fixture(scope="module")
 def peer(test_dictionary):
-    network = SimulatedNetwork("1,2,3", device="testdrive", dictionaries={"testdrive": test_dictionary},
-                               behaviour_factory=counting_factory)
+    network = SimulatedNetwork(
+        "1,2,3", device="testdrive", dictionaries={"testdrive": test_dictionary}, behaviour_factory=counting_factory
+    )
     network.start()
     server = SocketcandServer(network, port=0).start()
     host, port = server.address

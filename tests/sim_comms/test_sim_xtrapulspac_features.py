@@ -22,8 +22,12 @@ from .test_sim_nmt_pdo import frames_with_id, write
 
 @pytest.fixture
 def client(raw_client, tmp_path):
-    network = SimulatedNetwork("1", dictionaries={"xtrapulspac": builtin_library().load("xtrapulspac")},
-                               behaviour_factory=counting_factory, state_dir=tmp_path)
+    network = SimulatedNetwork(
+        "1",
+        dictionaries={"xtrapulspac": builtin_library().load("xtrapulspac")},
+        behaviour_factory=counting_factory,
+        state_dir=tmp_path,
+    )
     client = raw_client(network)
     client.collect(0.001)
     return client
@@ -87,8 +91,12 @@ def test_sequence_txt_is_loaded_at_power_on(tmp_path):
     folder = tmp_path / "node2"
     folder.mkdir()
     (folder / "SEQUENCE.TXT").write_text(format_sequence_table(SequenceTable({9: Sequence.of(SequenceType.SPEED)})))
-    network = SimulatedNetwork("2", dictionaries={"xtrapulspac": builtin_library().load("xtrapulspac")},
-                               behaviour_factory=counting_factory, state_dir=tmp_path)
+    network = SimulatedNetwork(
+        "2",
+        dictionaries={"xtrapulspac": builtin_library().load("xtrapulspac")},
+        behaviour_factory=counting_factory,
+        state_dir=tmp_path,
+    )
     assert network.node(2).sequences.record(9)[1] == int(SequenceType.SPEED)
 
 

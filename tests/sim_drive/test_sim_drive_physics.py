@@ -20,8 +20,13 @@ def velocity_rad(h) -> float:
 
 def free_plant(**changes) -> Plant:
     """The commissioned axis without switches/stops in the way."""
-    base = dict(negative_limit_switch=None, positive_limit_switch=None, negative_hard_stop=None,
-                positive_hard_stop=None, home_switch=None)
+    base = dict(
+        negative_limit_switch=None,
+        positive_limit_switch=None,
+        negative_hard_stop=None,
+        positive_hard_stop=None,
+        home_switch=None,
+    )
     base.update(changes)
     return replace(Plant.commissioned(), **base)
 
@@ -41,7 +46,8 @@ def test_pv_acceleration_at_the_current_limit_matches_the_hidden_plant(harness):
     current = 0.5 * plant.stall_current
     mean_speed = (v1 + v2) / 2
     expected = (plant.torque_constant * current - plant.coulomb_friction - plant.viscous_friction * mean_speed) / (
-        plant.total_inertia)
+        plant.total_inertia
+    )
     assert measured == pytest.approx(expected, rel=0.05)
 
 
@@ -106,8 +112,9 @@ def test_gravity_pulls_an_unpowered_axis_and_a_brake_holds_it():
 
 
 def test_two_mass_coupling_rings_at_its_resonance():
-    plant = free_plant(load_inertia=2e-4, coupling_stiffness=200.0, coupling_damping=0.0, coulomb_friction=0.0,
-                       viscous_friction=0.0)
+    plant = free_plant(
+        load_inertia=2e-4, coupling_stiffness=200.0, coupling_damping=0.0, coulomb_friction=0.0, viscous_friction=0.0
+    )
     physics = AxisPhysics(plant, CONTROL_PERIOD)
     physics.theta_motor += 0.01  # twist the coupling
     crossings = 0

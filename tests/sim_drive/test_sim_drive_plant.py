@@ -64,13 +64,28 @@ def test_missing_file(tmp_path):
 
 
 json_values = st.recursive(
-    st.none() | st.booleans() | st.integers(-10**6, 10**6) | st.floats(allow_nan=False, allow_infinity=False)
+    st.none()
+    | st.booleans()
+    | st.integers(-(10**6), 10**6)
+    | st.floats(allow_nan=False, allow_infinity=False)
     | st.text(max_size=5),
     lambda children: st.lists(children, max_size=3),
     max_leaves=5,
 )
-keys = st.sampled_from(["pole_pairs", "phase_order", "torque_constant", "home_switch", "feedback", "has_brake",
-                        "negative_limit_switch", "encoder_counts", "coupling_stiffness", "bogus"])
+keys = st.sampled_from(
+    [
+        "pole_pairs",
+        "phase_order",
+        "torque_constant",
+        "home_switch",
+        "feedback",
+        "has_brake",
+        "negative_limit_switch",
+        "encoder_counts",
+        "coupling_stiffness",
+        "bogus",
+    ]
+)
 
 
 @settings(max_examples=200, deadline=None)

@@ -91,8 +91,7 @@ def test_procedure_cannot_execute_while_enabled(harness):
 
 
 def test_procedure_fails_with_error_64_on_an_active_limit_switch(harness):
-    plant = replace(Plant.commissioned(), negative_limit_switch=-20.0, initial_position=-20.5,
-                    negative_hard_stop=-21.0)
+    plant = replace(Plant.commissioned(), negative_limit_switch=-20.0, initial_position=-20.5, negative_hard_stop=-21.0)
     h = harness(plant=plant)
     h.run(0.001)
     h.write(0x3413, 0, APHA)
@@ -131,8 +130,9 @@ def test_incremental_encoder_needs_motor_phasing_before_enable(harness):
     assert not h.read(0x3024) & (1 << 30)
     # the offset makes the drive's angle equal to the true one for this power-up's counter
     physics = h.drive.physics
-    drive_angle = 2 * math.pi * (plant.pole_pairs * physics.sensor_counts() / physics.counts_per_turn
-                                 + h.read(0x3410, 3) / 65536)
+    drive_angle = (
+        2 * math.pi * (plant.pole_pairs * physics.sensor_counts() / physics.counts_per_turn + h.read(0x3410, 3) / 65536)
+    )
     error = (drive_angle - physics.true_electrical_angle() + math.pi) % (2 * math.pi) - math.pi
     assert abs(error) < math.radians(3)
 

@@ -58,12 +58,14 @@ def _mount_ui(app: FastAPI, static_dir: Path) -> None:
     """Serve the built browser UI; every non-API path falls back to index.html (client-side routing)."""
     index = static_dir / "index.html"
     if not index.is_file():
+
         @app.get("/", include_in_schema=False)
         def ui_missing() -> HTMLResponse:
             return HTMLResponse(
                 "<h1>Servo Studio</h1><p>The browser UI is not built: run <code>make run</code>.</p>",
                 status_code=503,
             )
+
         return
     assets = static_dir / "assets"
     if assets.is_dir():

@@ -34,13 +34,25 @@ def _add_serve(commands: argparse._SubParsersAction) -> None:
     serve.add_argument("--host", default="127.0.0.1", help="address to bind (default: 127.0.0.1)")
     serve.add_argument("--port", type=int, default=8000, help="TCP port (default: 8000)")
     serve.add_argument("--projects", type=Path, default=Path("projects"), help="project store directory")
-    serve.add_argument("--user-eds", type=Path, default=DEFAULT_USER_EDS_DIR, metavar="DIR",
-                       help=f"directory of imported EDS files (default: {DEFAULT_USER_EDS_DIR})")
-    serve.add_argument("--allow-remote", action="store_true",
-                       help="accept a non-loopback --host (there is no login yet: only inside a container or a "
-                            "trusted network)")
-    serve.add_argument("--bus", action="append", default=[], metavar="SPEC",
-                       help="bus to open at startup, repeatable (default: sim, the embedded simulated drives)")
+    serve.add_argument(
+        "--user-eds",
+        type=Path,
+        default=DEFAULT_USER_EDS_DIR,
+        metavar="DIR",
+        help=f"directory of imported EDS files (default: {DEFAULT_USER_EDS_DIR})",
+    )
+    serve.add_argument(
+        "--allow-remote",
+        action="store_true",
+        help="accept a non-loopback --host (there is no login yet: only inside a container or a trusted network)",
+    )
+    serve.add_argument(
+        "--bus",
+        action="append",
+        default=[],
+        metavar="SPEC",
+        help="bus to open at startup, repeatable (default: sim, the embedded simulated drives)",
+    )
     serve.set_defaults(handler=_serve)
 
 
@@ -51,8 +63,11 @@ def check_bind_host(host: str, allow_remote: bool) -> None:
     except ValueError:
         local = False
     if not (local or allow_remote):
-        raise CommandError(f"--host {host}: the server binds to localhost only (127.0.0.1, ::1); "
-                           "pass --allow-remote to accept connections from other machines", EXIT_USAGE)
+        raise CommandError(
+            f"--host {host}: the server binds to localhost only (127.0.0.1, ::1); "
+            "pass --allow-remote to accept connections from other machines",
+            EXIT_USAGE,
+        )
 
 
 def _serve(args: argparse.Namespace) -> int:

@@ -44,11 +44,16 @@ CONNECT_WAIT = 3.0
 
 
 def register(commands: argparse._SubParsersAction) -> None:
-    def add(name: str, help_text: str, handler: Callable[[argparse.Namespace, BusConnection], object],
-            node: str = "one") -> argparse.ArgumentParser:
+    def add(
+        name: str, help_text: str, handler: Callable[[argparse.Namespace, BusConnection], object], node: str = "one"
+    ) -> argparse.ArgumentParser:
         parser = commands.add_parser(name, help=help_text)
-        parser.add_argument("--bus", required=True, metavar="SPEC", help="e.g. socketcand:127.0.0.1:29536, "
-                            "serial:/dev/ttyUSB0@19200, socketcan:can0, sim")
+        parser.add_argument(
+            "--bus",
+            required=True,
+            metavar="SPEC",
+            help="e.g. socketcand:127.0.0.1:29536, serial:/dev/ttyUSB0@19200, socketcan:can0, sim",
+        )
         if node == "one":
             parser.add_argument("--node", type=int, required=True, help="node ID 1..127")
             parser.add_argument("--device", help="device key when the node does not identify itself")
@@ -66,21 +71,33 @@ def register(commands: argparse._SubParsersAction) -> None:
     write.add_argument("value", metavar="VALUE", help="number, 0x hex, enumeration label or text")
     write.add_argument("--physical", action="store_true", help="VALUE is in the object's unit")
     backup = add("backup", "back up drive files (DRIVEPAR.TXT, USER_PAR.TXT, SEQUENCE.TXT)", _backup, node="many")
-    backup.add_argument("--out", type=Path, required=True, help="file (one node: kind from its name) or directory "
-                        "(DIR/node<N>/ per node)")
+    backup.add_argument(
+        "--out",
+        type=Path,
+        required=True,
+        help="file (one node: kind from its name) or directory (DIR/node<N>/ per node)",
+    )
     restore = add("restore", "validate, write, verify and store drive files", _restore, node="many")
     restore.add_argument("--in", dest="source", type=Path, required=True, help="file (one node) or directory")
     restore.add_argument("--no-store", action="store_true", help="do not store to flash afterwards")
     nmt = add("nmt", "send an NMT command", _nmt, node="none")
-    nmt.add_argument("command_name", metavar="COMMAND", help="start, stop, pre-operational, reset-node, "
-                     "reset-communication")
+    nmt.add_argument(
+        "command_name", metavar="COMMAND", help="start, stop, pre-operational, reset-node, reset-communication"
+    )
     nmt.add_argument("--node", type=int, default=0, help="node ID (default 0: all nodes)")
     fault = add("fault", "show active faults with the manual's remedy; --reset resets them", _fault)
     fault.add_argument("--reset", action="store_true")
-    state = add("state", "show the CiA 402 state, or walk to TARGET (operation-enabled holds the axis enabled "
-                         "until the command is interrupted, then quick-stops it)", _state)
-    state.add_argument("target", nargs="?", help="switch-on-disabled, ready-to-switch-on, switched-on, "
-                       "operation-enabled, quick-stop-active")
+    state = add(
+        "state",
+        "show the CiA 402 state, or walk to TARGET (operation-enabled holds the axis enabled "
+        "until the command is interrupted, then quick-stops it)",
+        _state,
+    )
+    state.add_argument(
+        "target",
+        nargs="?",
+        help="switch-on-disabled, ready-to-switch-on, switched-on, operation-enabled, quick-stop-active",
+    )
 
 
 def _run(args: argparse.Namespace, handler: Callable[[argparse.Namespace, BusConnection], object]) -> int:
@@ -88,8 +105,9 @@ def _run(args: argparse.Namespace, handler: Callable[[argparse.Namespace, BusCon
     try:
         connection = manager.open(args.bus, wait=CONNECT_WAIT)
         if not connection.link.connected:
-            raise CommandError(f"bus {args.bus}: not connected ({connection.link.last_error or 'no answer'})",
-                               EXIT_COMMUNICATION)
+            raise CommandError(
+                f"bus {args.bus}: not connected ({connection.link.last_error or 'no answer'})", EXIT_COMMUNICATION
+            )
         return emit(handler(args, connection))
     except (UnknownBusOrNode, ProfileError, UnknownObjectError) as error:
         raise CommandError(str(error), EXIT_NOT_FOUND) from None
@@ -109,8 +127,11 @@ def _drive(args: argparse.Namespace, connection: BusConnection, node: int | None
         if info is None:
             raise CommandError(f"node {node} does not answer on {connection.spec}", EXIT_COMMUNICATION)
         if info.device is None:
-            raise CommandError(f"node {node} (vendor 0x{info.vendor_id or 0:X}, product 0x{info.product_code or 0:X}) "
-                               "matches no dictionary of the EDS library; give --device", EXIT_NOT_FOUND)
+            raise CommandError(
+                f"node {node} (vendor 0x{info.vendor_id or 0:X}, product 0x{info.product_code or 0:X}) "
+                "matches no dictionary of the EDS library; give --device",
+                EXIT_NOT_FOUND,
+            )
     return connection.drive(node, device)
 
 
@@ -160,17 +181,22 @@ def _restore(args: argparse.Namespace, connection: BusConnection) -> object:
         folder = source / f"node{drive.node}"
         kinds = [kind for kind in drive_file_kinds(drive) if (folder / kind.value).is_file()]
         if not kinds:
-            raise RestoreValidationError(f"{folder}: no DRIVEPAR.TXT, USER_PAR.TXT or SEQUENCE.TXT "
-                                         f"for node {drive.node}")
+            raise RestoreValidationError(
+                f"{folder}: no DRIVEPAR.TXT, USER_PAR.TXT or SEQUENCE.TXT for node {drive.node}"
+            )
         return [restore_file(drive, folder / kind.value, kind, store=not args.no_store) for kind in kinds]
 
     results = run_per_drive(drives, restore_all)
-    return _collect(results, lambda items: [item.as_dict() for item in items],
-                    failed=lambda items: any(not item.ok for item in items))
+    return _collect(
+        results,
+        lambda items: [item.as_dict() for item in items],
+        failed=lambda items: any(not item.ok for item in items),
+    )
 
 
-def _collect(results: dict[int, object], show: Callable[[object], object],
-             failed: Callable[[object], bool] = lambda _: False) -> object:
+def _collect(
+    results: dict[int, object], show: Callable[[object], object], failed: Callable[[object], bool] = lambda _: False
+) -> object:
     """Per-node results; the first failure decides the exit code after everything was tried."""
     shown: dict[str, object] = {}
     errors = []
@@ -222,11 +248,16 @@ def _hold_enabled(drive: Drive) -> None:
     """Motion needs a live client: this command is it. The axis stays enabled while the command runs and gets a
     quick stop when it ends (Ctrl-C, SIGTERM, SIGHUP)."""
     stop = threading.Event()
-    previous = {sig: signal.signal(sig, lambda *_: stop.set()) for sig in (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)}
+    previous = {
+        sig: signal.signal(sig, lambda *_: stop.set()) for sig in (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
+    }
     try:
         set_state(drive, State.OPERATION_ENABLED)
-        print(f"node {drive.node}: operation enabled; holding until Ctrl-C or SIGTERM, then quick stop",
-              file=sys.stderr, flush=True)
+        print(
+            f"node {drive.node}: operation enabled; holding until Ctrl-C or SIGTERM, then quick stop",
+            file=sys.stderr,
+            flush=True,
+        )
         stop.wait()
     finally:
         set_state(drive, State.QUICK_STOP_ACTIVE)

@@ -38,16 +38,34 @@ def _library(args: argparse.Namespace) -> EdsLibrary:
 
 
 def _describe(od) -> dict:
-    return {"device": od.device, "product_name": od.product_name, "vendor_id": od.vendor_id,
-            "product_code": od.product_code, "revision": od.revision, "objects": len(od.objects()),
-            "entries": len(od), "source": str(od.source)}
+    return {
+        "device": od.device,
+        "product_name": od.product_name,
+        "vendor_id": od.vendor_id,
+        "product_code": od.product_code,
+        "revision": od.revision,
+        "objects": len(od.objects()),
+        "entries": len(od),
+        "source": str(od.source),
+    }
 
 
 def _entry(var) -> dict:
-    return {"index": f"0x{var.index:04X}", "subindex": var.subindex, "name": var.name,
-            "object": var.parent_name, "data_type": var.data_type.name, "access": var.access.value,
-            "low": var.low, "high": var.high, "default": var.default_expr, "unit": var.unit,
-            "save_type": var.save_type.value, "group": var.group, "description": var.description}
+    return {
+        "index": f"0x{var.index:04X}",
+        "subindex": var.subindex,
+        "name": var.name,
+        "object": var.parent_name,
+        "data_type": var.data_type.name,
+        "access": var.access.value,
+        "low": var.low,
+        "high": var.high,
+        "default": var.default_expr,
+        "unit": var.unit,
+        "save_type": var.save_type.value,
+        "group": var.group,
+        "description": var.description,
+    }
 
 
 def _list(args: argparse.Namespace) -> int:

@@ -7,9 +7,9 @@ import sys
 from typing import Any
 
 EXIT_OK = 0
-EXIT_USAGE = 2          # argparse's own code for bad arguments
+EXIT_USAGE = 2  # argparse's own code for bad arguments
 EXIT_INVALID_INPUT = 3  # a file or value was refused (nothing was written)
-EXIT_NOT_FOUND = 4      # unknown device, project, node or object
+EXIT_NOT_FOUND = 4  # unknown device, project, node or object
 EXIT_COMMUNICATION = 5  # the bus or a drive did not answer, or refused (SDO abort)
 
 

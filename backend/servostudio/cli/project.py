@@ -51,22 +51,34 @@ def register(commands: argparse._SubParsersAction) -> None:
         parser.add_argument("--revision", help="refuse the change if the project changed since this revision")
 
     def via(parser: argparse.ArgumentParser) -> None:
-        parser.add_argument("--via", action="append", default=[], metavar="BUS=SPEC",
-                            help="reach a project bus through another bus spec for this command, e.g. "
-                            "sim=socketcand:127.0.0.1:29536 (repeatable)")
+        parser.add_argument(
+            "--via",
+            action="append",
+            default=[],
+            metavar="BUS=SPEC",
+            help="reach a project bus through another bus spec for this command, e.g. "
+            "sim=socketcand:127.0.0.1:29536 (repeatable)",
+        )
 
     action("list", _list, "projects of the store")
     create = action("create", _create, "create an empty project")
     create.add_argument("name")
     create.add_argument("--description", default="")
-    create.add_argument("--bus", action="append", default=[], metavar="NAME=INTERFACE[@BITRATE]",
-                        help="a bus, e.g. sim=sim or can0=socketcan:can0@500000 (repeatable)")
+    create.add_argument(
+        "--bus",
+        action="append",
+        default=[],
+        metavar="NAME=INTERFACE[@BITRATE]",
+        help="a bus, e.g. sim=sim or can0=socketcan:can0@500000 (repeatable)",
+    )
     action("show", _show, "a project with its buses and axes").add_argument("name")
     delete = action("delete", _delete, "delete a project")
     delete.add_argument("name")
     revision(delete)
-    for name, handler, text in (("rename", _rename, "rename a project"),
-                                ("duplicate", _duplicate, "copy a project under a new name")):
+    for name, handler, text in (
+        ("rename", _rename, "rename a project"),
+        ("duplicate", _duplicate, "copy a project under a new name"),
+    ):
         parser = action(name, handler, text)
         parser.add_argument("name")
         parser.add_argument("new_name")
@@ -137,17 +149,28 @@ def register(commands: argparse._SubParsersAction) -> None:
     commission = action("commission", _commission, "check every axis's drive; --download or --upload the files")
     commission.add_argument("name")
     direction = commission.add_mutually_exclusive_group()
-    direction.add_argument("--download", dest="direction", action="store_const", const="download",
-                           help="project values → drives (validated, written, verified, stored)")
-    direction.add_argument("--upload", dest="direction", action="store_const", const="upload",
-                           help="drives' files → project")
+    direction.add_argument(
+        "--download",
+        dest="direction",
+        action="store_const",
+        const="download",
+        help="project values → drives (validated, written, verified, stored)",
+    )
+    direction.add_argument(
+        "--upload", dest="direction", action="store_const", const="upload", help="drives' files → project"
+    )
     commission.add_argument("--axis", action="append", dest="axes", metavar="AXIS", help="only this axis (repeatable)")
     revision(commission)
     via(commission)
     scan = action("scan", _scan, "scan a bus and add an axis for every identified node")
     scan.add_argument("name")
-    scan.add_argument("--bus", required=True, metavar="BUS_OR_SPEC", help="a bus of the project or a bus spec, e.g. "
-                      "sim or socketcand:127.0.0.1:29536 (a new spec is added to the project)")
+    scan.add_argument(
+        "--bus",
+        required=True,
+        metavar="BUS_OR_SPEC",
+        help="a bus of the project or a bus spec, e.g. "
+        "sim or socketcand:127.0.0.1:29536 (a new spec is added to the project)",
+    )
     scan.add_argument("--bus-name", help="name of the new bus (default: derived from the spec)")
     scan.add_argument("--create", action="store_true", help="create the project if it does not exist")
     revision(scan)
@@ -171,8 +194,9 @@ def register(commands: argparse._SubParsersAction) -> None:
     select.add_argument("name")
     select.add_argument("axis")
     select.add_argument("reference")
-    select.add_argument("--drive", action="store_true", help="write the motor to the live drive and read back what "
-                        "it derived")
+    select.add_argument(
+        "--drive", action="store_true", help="write the motor to the live drive and read back what it derived"
+    )
     revision(select)
     via(select)
     templates = action("template-list", _template_list, "Device Config templates of a device")
@@ -262,9 +286,17 @@ def _axis_add(service: ProjectService, args: argparse.Namespace) -> dict:
 
 
 def _axis_edit(service: ProjectService, args: argparse.Namespace) -> dict:
-    changes = {key: value for key, value in (("name", args.new_name), ("device", args.device),
-                                             ("node_id", args.node), ("bus", args.bus),
-                                             ("description", args.description)) if value is not None}
+    changes = {
+        key: value
+        for key, value in (
+            ("name", args.new_name),
+            ("device", args.device),
+            ("node_id", args.node),
+            ("bus", args.bus),
+            ("description", args.description),
+        )
+        if value is not None
+    }
     return project_view(service.store.edit_axis(args.name, args.axis, args.revision, **changes))
 
 
@@ -294,20 +326,32 @@ def _reset(service: ProjectService, args: argparse.Namespace) -> dict:
 
 
 def _params(service: ProjectService, args: argparse.Namespace) -> dict:
-    rows, revision = service.parameters.rows(args.name, args.axis, group=args.group, only_set=args.only_set,
-                                             only_differences=args.only_differences, include_unsaved=args.all)
+    rows, revision = service.parameters.rows(
+        args.name,
+        args.axis,
+        group=args.group,
+        only_set=args.only_set,
+        only_differences=args.only_differences,
+        include_unsaved=args.all,
+    )
     return {"parameters": [parameter_view(row) for row in rows], "revision": revision}
 
 
 def _compare(service: ProjectService, args: argparse.Namespace) -> dict:
     if not args.drive:
-        rows, revision = service.parameters.compare(args.name, args.axis, group=args.group,
-                                                    only_differences=args.only_differences)
+        rows, revision = service.parameters.compare(
+            args.name, args.axis, group=args.group, only_differences=args.only_differences
+        )
         return {"columns": ["project", "default"], "rows": [compare_view(row) for row in rows], "revision": revision}
-    live = _live(service, args).compare(args.name, args.axis, group=args.group, only_differences=args.only_differences,
-                                  buses=_via(args))
-    return {"columns": ["drive", "project", "default"], "rows": [compare_view(row) for row in live.rows],
-            "revision": live.revision, "refused": live.refused}
+    live = _live(service, args).compare(
+        args.name, args.axis, group=args.group, only_differences=args.only_differences, buses=_via(args)
+    )
+    return {
+        "columns": ["drive", "project", "default"],
+        "rows": [compare_view(row) for row in live.rows],
+        "revision": live.revision,
+        "refused": live.refused,
+    }
 
 
 def _take(service: ProjectService, args: argparse.Namespace) -> dict:
@@ -331,14 +375,20 @@ def _commission(service: ProjectService, args: argparse.Namespace) -> dict:
     failed = [axis for axis in report.axes if not axis.ok]
     only_mismatch = all(axis.link.status == "wrong_device" for axis in failed)
     names = ", ".join(axis.link.axis.name for axis in failed)
-    raise CommandError(f"project '{args.name}': axes {names} not commissioned (see the report)",
-                       EXIT_INVALID_INPUT if only_mismatch else EXIT_COMMUNICATION)
+    raise CommandError(
+        f"project '{args.name}': axes {names} not commissioned (see the report)",
+        EXIT_INVALID_INPUT if only_mismatch else EXIT_COMMUNICATION,
+    )
 
 
 def _scan(service: ProjectService, args: argparse.Namespace) -> dict:
     report = _live(service, args).scan(args.name, args.bus, args.bus_name, args.revision, args.create)
-    return {"bus": report.bus.name, "bus_added": report.bus_added, "nodes": [node.as_dict() for node in report.nodes],
-            "project": project_view(report.snapshot)}
+    return {
+        "bus": report.bus.name,
+        "bus_added": report.bus_added,
+        "nodes": [node.as_dict() for node in report.nodes],
+        "project": project_view(report.snapshot),
+    }
 
 
 def _archive(service: ProjectService, args: argparse.Namespace) -> dict:
@@ -374,8 +424,9 @@ def _motor_remove(service: ProjectService, args: argparse.Namespace) -> dict:
 
 def _motor_select(service: ProjectService, args: argparse.Namespace) -> dict:
     if args.drive:
-        return choice_view(_live(service, args).select_motor(args.name, args.axis, args.reference, args.revision,
-                                                       _via(args)))
+        return choice_view(
+            _live(service, args).select_motor(args.name, args.axis, args.reference, args.revision, _via(args))
+        )
     return choice_view(service.select_motor(args.name, args.axis, args.reference, args.revision))
 
 

@@ -14,9 +14,9 @@ from __future__ import annotations
 from collections.abc import Callable, Sequence
 from concurrent.futures import Future
 
+from servostudio.drive.object_values import ObjectValue, Raw, decode_raw, parse_input
 from servostudio.drive.profiles import DeviceProfile, profile_for
 from servostudio.drive.sdo import SdoEngine, TransferBatch
-from servostudio.drive.values import ObjectValue, Raw, decode_raw, parse_input
 from servostudio.od.datatypes import DataType, encode
 from servostudio.od.model import Access, ObjectDictionary, Variable
 
@@ -36,8 +36,9 @@ class UnknownObjectError(DriveAccessError, LookupError):
 class Drive:
     """One node on one bus, with its dictionary and device profile."""
 
-    def __init__(self, engine: SdoEngine, node: int, dictionary: ObjectDictionary | None,
-                 profile: DeviceProfile | None = None) -> None:
+    def __init__(
+        self, engine: SdoEngine, node: int, dictionary: ObjectDictionary | None, profile: DeviceProfile | None = None
+    ) -> None:
         self.engine = engine
         self.node = node
         self.dictionary = dictionary
@@ -52,45 +53,61 @@ class Drive:
         if isinstance(key, str) and self.profile.has(key):
             key = self.profile.address(key)
         if self.dictionary is None:
-            raise UnknownObjectError(f"node {self.node}: no object dictionary known (the node did not answer or "
-                                     "matches no EDS of the library); scan the bus or name the device")
+            raise UnknownObjectError(
+                f"node {self.node}: no object dictionary known (the node did not answer or "
+                "matches no EDS of the library); scan the bus or name the device"
+            )
         try:
             if isinstance(key, tuple):
                 return self.dictionary[key]
             return self.dictionary.find(key)
         except KeyError:
             shown = f"0x{key[0]:04X},{key[1]}" if isinstance(key, tuple) else repr(key)
-            raise UnknownObjectError(f"node {self.node}: object {shown} is not in the {self.dictionary.device} "
-                                   "dictionary") from None
+            raise UnknownObjectError(
+                f"node {self.node}: object {shown} is not in the {self.dictionary.device} dictionary"
+            ) from None
 
     # -- reads ---------------------------------------------------------------------------------------------------
     def submit_read(self, variable: Variable, timeout: float | None = None) -> Future:
         """Queue a read; the future gives an ObjectValue."""
         if not variable.access.readable:
             raise DriveAccessError(f"node {self.node}: {variable.label} is write-only")
-        return self.engine.upload(self.node, variable.index, variable.subindex, timeout,
-                                  convert=lambda data: ObjectValue(self.node, variable, decode_raw(variable, data)))
+        return self.engine.upload(
+            self.node,
+            variable.index,
+            variable.subindex,
+            timeout,
+            convert=lambda data: ObjectValue(self.node, variable, decode_raw(variable, data)),
+        )
 
-    def submit_read_all(self, variables: Sequence[Variable],
-                        on_each: Callable[[int, ObjectValue | Exception], None] | None = None) -> TransferBatch:
+    def submit_read_all(
+        self, variables: Sequence[Variable], on_each: Callable[[int, ObjectValue | Exception], None] | None = None
+    ) -> TransferBatch:
         """Queue reads of many objects at once; the batch's future gives, in order, an ObjectValue or the exception
         that ended each read (see `TransferBatch`)."""
         for variable in variables:
             if not variable.access.readable:
                 raise DriveAccessError(f"node {self.node}: {variable.label} is write-only")
         return self.engine.upload_all(
-            self.node, [(variable.index, variable.subindex) for variable in variables],
-            convert=lambda position, data: ObjectValue(self.node, variables[position],
-                                                       decode_raw(variables[position], data)),
-            on_each=on_each)
+            self.node,
+            [(variable.index, variable.subindex) for variable in variables],
+            convert=lambda position, data: ObjectValue(
+                self.node, variables[position], decode_raw(variables[position], data)
+            ),
+            on_each=on_each,
+        )
 
     def read(self, key: str | tuple[int, int] | Variable, timeout: float | None = None) -> ObjectValue:
         variable = key if isinstance(key, Variable) else self.variable(key)
         return self.submit_read(variable, timeout).result(DEFAULT_WAIT + (timeout or 0))
 
     # -- writes --------------------------------------------------------------------------------------------------
-    def prepare_write(self, key: str | tuple[int, int] | Variable, value: object, physical: bool = False,
-                      ) -> tuple[Variable, Raw, bytes]:
+    def prepare_write(
+        self,
+        key: str | tuple[int, int] | Variable,
+        value: object,
+        physical: bool = False,
+    ) -> tuple[Variable, Raw, bytes]:
         """Check a write completely without sending anything; returns (variable, raw value, bytes to send)."""
         variable = key if isinstance(key, Variable) else self.variable(key)
         if not variable.access.writable:
@@ -103,25 +120,38 @@ class Drive:
             raise DriveAccessError(f"node {self.node}: {error}") from None
         return variable, raw, data
 
-    def submit_write(self, key: str | tuple[int, int] | Variable, value: object, physical: bool = False,
-                     timeout: float | None = None) -> Future:
+    def submit_write(
+        self, key: str | tuple[int, int] | Variable, value: object, physical: bool = False, timeout: float | None = None
+    ) -> Future:
         """Check, then queue a write; the future gives the ObjectValue written."""
         variable, raw, data = self.prepare_write(key, value, physical)
-        return self.engine.download(self.node, variable.index, variable.subindex, data, timeout,
-                                    convert=lambda _: ObjectValue(self.node, variable, raw))
+        return self.engine.download(
+            self.node,
+            variable.index,
+            variable.subindex,
+            data,
+            timeout,
+            convert=lambda _: ObjectValue(self.node, variable, raw),
+        )
 
-    def submit_write_all(self, writes: Sequence[tuple[Variable, object]],
-                         on_each: Callable[[int, ObjectValue | Exception], None] | None = None) -> TransferBatch:
+    def submit_write_all(
+        self,
+        writes: Sequence[tuple[Variable, object]],
+        on_each: Callable[[int, ObjectValue | Exception], None] | None = None,
+    ) -> TransferBatch:
         """Check every write, then queue them all (nothing is sent if one fails its check); the batch's future
         gives, in order, the ObjectValue written or the exception that ended each write (see `TransferBatch`)."""
         prepared = [self.prepare_write(variable, value) for variable, value in writes]
         return self.engine.download_all(
-            self.node, [(variable.index, variable.subindex, data) for variable, _, data in prepared],
+            self.node,
+            [(variable.index, variable.subindex, data) for variable, _, data in prepared],
             convert=lambda position, _: ObjectValue(self.node, prepared[position][0], prepared[position][1]),
-            on_each=on_each)
+            on_each=on_each,
+        )
 
-    def write(self, key: str | tuple[int, int] | Variable, value: object, physical: bool = False,
-              timeout: float | None = None) -> ObjectValue:
+    def write(
+        self, key: str | tuple[int, int] | Variable, value: object, physical: bool = False, timeout: float | None = None
+    ) -> ObjectValue:
         return self.submit_write(key, value, physical, timeout).result(DEFAULT_WAIT + (timeout or 0))
 
     def write_raw_bytes(self, index: int, sub: int, data: bytes, timeout: float | None = None) -> None:

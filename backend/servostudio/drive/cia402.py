@@ -22,14 +22,20 @@ class State(str, enum.Enum):
     @classmethod
     def parse(cls, text: str) -> State:
         key = text.strip().upper().replace("-", " ").replace("_", " ")
-        aliases = {"ENABLED": "OPERATION ENABLED", "OPERATION ENABLE": "OPERATION ENABLED", "DISABLED":
-                   "SWITCH ON DISABLED", "READY": "READY TO SWITCH ON"}
+        aliases = {
+            "ENABLED": "OPERATION ENABLED",
+            "OPERATION ENABLE": "OPERATION ENABLED",
+            "DISABLED": "SWITCH ON DISABLED",
+            "READY": "READY TO SWITCH ON",
+        }
         key = aliases.get(key, key)
         for state in cls:
             if state.value == key:
                 return state
-        raise ValueError(f"unknown CiA 402 state {text!r}; use one of: "
-                         + ", ".join(state.value.lower().replace(" ", "-") for state in cls))
+        raise ValueError(
+            f"unknown CiA 402 state {text!r}; use one of: "
+            + ", ".join(state.value.lower().replace(" ", "-") for state in cls)
+        )
 
 
 _DECODING = [  # (mask, value, state), first match wins
@@ -73,10 +79,16 @@ def apply_command(controlword: int, command: Command) -> int:
 
 _NEXT_STEP: dict[tuple[State, State], Command] = {}
 _ORDER = [State.SWITCH_ON_DISABLED, State.READY_TO_SWITCH_ON, State.SWITCHED_ON, State.OPERATION_ENABLED]
-_UP = {State.SWITCH_ON_DISABLED: Command.SHUTDOWN, State.READY_TO_SWITCH_ON: Command.SWITCH_ON,
-       State.SWITCHED_ON: Command.ENABLE_OPERATION}
-_DOWN = {State.OPERATION_ENABLED: Command.DISABLE_OPERATION, State.SWITCHED_ON: Command.SHUTDOWN,
-         State.READY_TO_SWITCH_ON: Command.DISABLE_VOLTAGE}
+_UP = {
+    State.SWITCH_ON_DISABLED: Command.SHUTDOWN,
+    State.READY_TO_SWITCH_ON: Command.SWITCH_ON,
+    State.SWITCHED_ON: Command.ENABLE_OPERATION,
+}
+_DOWN = {
+    State.OPERATION_ENABLED: Command.DISABLE_OPERATION,
+    State.SWITCHED_ON: Command.SHUTDOWN,
+    State.READY_TO_SWITCH_ON: Command.DISABLE_VOLTAGE,
+}
 
 
 def next_command(current: State, target: State) -> Command | None:

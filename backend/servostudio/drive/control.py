@@ -41,8 +41,10 @@ def set_state(drive: Drive, target: State, step_timeout: float = STEP_TIMEOUT) -
         drive.write("controlword", apply_command(controlword, command))
         _wait_for_change(drive, state, step_timeout)
     state, statusword = read_state(drive)
-    raise StateChangeError(f"node {drive.node}: stuck in {state.value if state else '?'} "
-                           f"(status word 0x{statusword:04X}) on the way to {target.value}")
+    raise StateChangeError(
+        f"node {drive.node}: stuck in {state.value if state else '?'} "
+        f"(status word 0x{statusword:04X}) on the way to {target.value}"
+    )
 
 
 def _wait_for_change(drive: Drive, previous: State, timeout: float) -> None:
@@ -53,8 +55,10 @@ def _wait_for_change(drive: Drive, previous: State, timeout: float) -> None:
             return
         time.sleep(POLL_PERIOD)
     state, statusword = read_state(drive)
-    raise StateChangeError(f"node {drive.node}: still {state.value if state else '?'} (status word "
-                           f"0x{statusword:04X}) {timeout:.1f} s after the command")
+    raise StateChangeError(
+        f"node {drive.node}: still {state.value if state else '?'} (status word "
+        f"0x{statusword:04X}) {timeout:.1f} s after the command"
+    )
 
 
 def _fault_names(drive: Drive) -> str:
@@ -81,11 +85,16 @@ class FaultReport:
     warnings: list[FaultInfo] = field(default_factory=list)
 
     def as_dict(self) -> dict[str, object]:
-        return {"node": self.node, "state": self.state, "statusword": self.statusword,
-                "fault": bool(self.statusword & 8),
-                "error_code": self.error_code, "error_text": self.error_text,
-                "faults": [item.as_dict() for item in self.faults],
-                "warnings": [item.as_dict() for item in self.warnings]}
+        return {
+            "node": self.node,
+            "state": self.state,
+            "statusword": self.statusword,
+            "fault": bool(self.statusword & 8),
+            "error_code": self.error_code,
+            "error_text": self.error_text,
+            "faults": [item.as_dict() for item in self.faults],
+            "warnings": [item.as_dict() for item in self.warnings],
+        }
 
 
 def fault_report(drive: Drive) -> FaultReport:

@@ -39,9 +39,15 @@ class Emergency:
         return self.cia402_code == 0
 
     def as_dict(self) -> dict[str, object]:
-        return {"node": self.node, "cia402_code": self.cia402_code, "cia402_text": cia402_error_text(self.cia402_code),
-                "error_register": self.error_register, "manufacturer": self.manufacturer.hex(),
-                "cleared": self.cleared, "faults": [fault.as_dict() for fault in self.faults]}
+        return {
+            "node": self.node,
+            "cia402_code": self.cia402_code,
+            "cia402_text": cia402_error_text(self.cia402_code),
+            "error_register": self.error_register,
+            "manufacturer": self.manufacturer.hex(),
+            "cleared": self.cleared,
+            "faults": [fault.as_dict() for fault in self.faults],
+        }
 
 
 _CIA402_CLASSES = [
@@ -59,11 +65,19 @@ _CIA402_CLASSES = [
     (0xFF00, 0xFFFF, "device specific"),
 ]
 _CIA402_KNOWN = {
-    0x2310: "continuous over current", 0x2350: "load level fault (I²t, thermal state)", 0x3210: "DC link overvoltage",
-    0x3220: "DC link undervoltage", 0x4210: "excess temperature device", 0x4290: "motor temperature",
-    0x5112: "supply low voltage", 0x6320: "parameter error", 0x7303: "resolver fault",
+    0x2310: "continuous over current",
+    0x2350: "load level fault (I²t, thermal state)",
+    0x3210: "DC link overvoltage",
+    0x3220: "DC link undervoltage",
+    0x4210: "excess temperature device",
+    0x4290: "motor temperature",
+    0x5112: "supply low voltage",
+    0x6320: "parameter error",
+    0x7303: "resolver fault",
     0x7305: "incremental sensor fault",
-    0x8130: "life guard error or heartbeat error", 0x8400: "velocity speed controller", 0x8611: "following error",
+    0x8130: "life guard error or heartbeat error",
+    0x8400: "velocity speed controller",
+    0x8611: "following error",
     0x8680: "software position limit",
 }
 

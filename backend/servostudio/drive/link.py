@@ -144,8 +144,11 @@ class BusLink:
             frames = receive_frames(POLL_INTERVAL)
         else:
             message = bus.recv(POLL_INTERVAL)
-            frames = [] if message is None or message.is_error_frame or message.is_remote_frame else [
-                (message.arbitration_id, bytes(message.data), message.timestamp, message.is_extended_id)]
+            frames = (
+                []
+                if message is None or message.is_error_frame or message.is_remote_frame
+                else [(message.arbitration_id, bytes(message.data), message.timestamp, message.is_extended_id)]
+            )
         if not frames:
             return
         self._held = []

@@ -18,8 +18,12 @@ class NmtCommand(enum.IntEnum):
     def parse(cls, text: str) -> NmtCommand:
         """Accept the names the CLI and REST use: start, stop, pre-operational, reset-node, reset-communication."""
         key = text.strip().lower().replace("-", "_").replace(" ", "_")
-        aliases = {"preop": "pre_operational", "reset": "reset_node", "reset_comm": "reset_communication",
-                   "operational": "start"}
+        aliases = {
+            "preop": "pre_operational",
+            "reset": "reset_node",
+            "reset_comm": "reset_communication",
+            "operational": "start",
+        }
         key = aliases.get(key, key)
         try:
             return cls[key.upper()]

@@ -20,8 +20,8 @@ import struct
 import threading
 import time
 from collections import deque
-from concurrent.futures import CancelledError, Future
 from collections.abc import Callable, Sequence
+from concurrent.futures import CancelledError, Future
 
 from servostudio.drive.abort_codes import abort_text
 from servostudio.drive.link import BusLink, LinkDownError
@@ -65,7 +65,7 @@ class SdoLinkError(SdoError):
 class _FutureCompletion:
     """The outcome of one transfer goes to a future (after ``convert`` of a successful result)."""
 
-    __slots__ = ("future", "convert")
+    __slots__ = ("convert", "future")
 
     def __init__(self, convert: Callable[[object], object] | None) -> None:
         self.future: Future = Future()
@@ -102,8 +102,12 @@ class TransferBatch:
     drops the rest the same way: a drive that stopped answering would otherwise cost a timeout per object.
     """
 
-    def __init__(self, count: int, convert: Callable[[int, bytes], object] | None = None,
-                 on_each: Callable[[int, object], None] | None = None) -> None:
+    def __init__(
+        self,
+        count: int,
+        convert: Callable[[int, bytes], object] | None = None,
+        on_each: Callable[[int, object], None] | None = None,
+    ) -> None:
         self.future: Future = Future()
         self.future.set_running_or_notify_cancel()
         self._outcomes: list[object] = [None] * count
@@ -146,13 +150,39 @@ class TransferBatch:
 class _Transfer:
     """One SDO transfer and where its state machine stands."""
 
-    __slots__ = ("node", "index", "sub", "multiplexer", "timeout", "download", "completion", "slot", "deadline",
-                 "received", "expected_size", "toggle", "offset", "segmented", "abort_on_timeout", "retries",
-                 "answered", "repeated")
+    __slots__ = (
+        "abort_on_timeout",
+        "answered",
+        "completion",
+        "deadline",
+        "download",
+        "expected_size",
+        "index",
+        "multiplexer",
+        "node",
+        "offset",
+        "received",
+        "repeated",
+        "retries",
+        "segmented",
+        "slot",
+        "sub",
+        "timeout",
+        "toggle",
+    )
 
-    def __init__(self, node: int, index: int, sub: int, timeout: float, completion: _FutureCompletion | TransferBatch,
-                 slot: int = 0, download: bytes | None = None, abort_on_timeout: bool = True,
-                 retries: int = 0) -> None:
+    def __init__(
+        self,
+        node: int,
+        index: int,
+        sub: int,
+        timeout: float,
+        completion: _FutureCompletion | TransferBatch,
+        slot: int = 0,
+        download: bytes | None = None,
+        abort_on_timeout: bool = True,
+        retries: int = 0,
+    ) -> None:
         self.node, self.index, self.sub, self.timeout = node, index, sub, timeout
         self.multiplexer = struct.pack("<HB", index, sub)  # index and subindex as every frame of the transfer has them
         self.download = download  # None: upload
@@ -195,42 +225,85 @@ class SdoEngine:
         link.after_dispatch(self._hand_over)  # responses arrive on the reader thread: complete after the batch
 
     # -- public API --------------------------------------------------------------------------------------------
-    def upload(self, node: int, index: int, sub: int, timeout: float | None = None, probe: bool = False,
-               convert: Callable[[bytes], object] | None = None) -> Future:
+    def upload(
+        self,
+        node: int,
+        index: int,
+        sub: int,
+        timeout: float | None = None,
+        probe: bool = False,
+        convert: Callable[[bytes], object] | None = None,
+    ) -> Future:
         """Read an object; the future gives its bytes, or ``convert(bytes)`` (a ValueError fails the future).
 
         A ``probe`` (scan) sends no abort when the node stays silent: there is nobody to tell, and on a slow serial
         link 127 useless abort frames would cost most of a second.
         """
         completion = _FutureCompletion(convert)
-        self._submit([_Transfer(node, index, sub, timeout or self.timeout, completion, abort_on_timeout=not probe,
-                                retries=0 if probe else UPLOAD_RETRIES)])
+        self._submit(
+            [
+                _Transfer(
+                    node,
+                    index,
+                    sub,
+                    timeout or self.timeout,
+                    completion,
+                    abort_on_timeout=not probe,
+                    retries=0 if probe else UPLOAD_RETRIES,
+                )
+            ]
+        )
         return completion.future
 
-    def upload_all(self, node: int, objects: Sequence[tuple[int, int]], timeout: float | None = None,
-                   convert: Callable[[int, bytes], object] | None = None,
-                   on_each: Callable[[int, object], None] | None = None) -> TransferBatch:
+    def upload_all(
+        self,
+        node: int,
+        objects: Sequence[tuple[int, int]],
+        timeout: float | None = None,
+        convert: Callable[[int, bytes], object] | None = None,
+        on_each: Callable[[int, object], None] | None = None,
+    ) -> TransferBatch:
         """Read many objects of one node, back to back, in order, with one future for all (see `TransferBatch`)."""
         batch = TransferBatch(len(objects), convert, on_each)
         timeout = timeout or self.timeout
-        self._submit([_Transfer(node, index, sub, timeout, batch, slot, retries=UPLOAD_RETRIES)
-                      for slot, (index, sub) in enumerate(objects)])
+        self._submit(
+            [
+                _Transfer(node, index, sub, timeout, batch, slot, retries=UPLOAD_RETRIES)
+                for slot, (index, sub) in enumerate(objects)
+            ]
+        )
         return batch
 
-    def download_all(self, node: int, writes: Sequence[tuple[int, int, bytes]], timeout: float | None = None,
-                     convert: Callable[[int, None], object] | None = None,
-                     on_each: Callable[[int, object], None] | None = None) -> TransferBatch:
+    def download_all(
+        self,
+        node: int,
+        writes: Sequence[tuple[int, int, bytes]],
+        timeout: float | None = None,
+        convert: Callable[[int, None], object] | None = None,
+        on_each: Callable[[int, object], None] | None = None,
+    ) -> TransferBatch:
         """Write many objects of one node, back to back, in order, with one future for all (see `TransferBatch`)."""
         if any(not data for _, _, data in writes):
             raise ValueError("an SDO download needs at least one byte")
         batch = TransferBatch(len(writes), convert, on_each)
         timeout = timeout or self.timeout
-        self._submit([_Transfer(node, index, sub, timeout, batch, slot, download=bytes(data))
-                      for slot, (index, sub, data) in enumerate(writes)])
+        self._submit(
+            [
+                _Transfer(node, index, sub, timeout, batch, slot, download=bytes(data))
+                for slot, (index, sub, data) in enumerate(writes)
+            ]
+        )
         return batch
 
-    def download(self, node: int, index: int, sub: int, data: bytes, timeout: float | None = None,
-                 convert: Callable[[None], object] | None = None) -> Future:
+    def download(
+        self,
+        node: int,
+        index: int,
+        sub: int,
+        data: bytes,
+        timeout: float | None = None,
+        convert: Callable[[None], object] | None = None,
+    ) -> Future:
         """Write an object; the future gives None (or ``convert(None)``) once the drive confirmed."""
         if not data:
             raise ValueError("an SDO download needs at least one byte")
@@ -300,9 +373,7 @@ class SdoEngine:
             except SdoError as error:
                 self._finish(transfer, error)
                 follow_up = None
-            if follow_up is None:
-                self._start_next(node)
-            elif not self._send(transfer, follow_up):
+            if follow_up is None or not self._send(transfer, follow_up):
                 self._start_next(node)
 
     def _advance(self, transfer: _Transfer, data: bytes) -> bytes | None:
@@ -360,8 +431,7 @@ class SdoEngine:
     def _expect(self, transfer: _Transfer, condition: bool, data: bytes) -> None:
         if not condition:
             self._abort(transfer, ABORT_COMMAND)
-            raise SdoError(transfer.node, transfer.index, transfer.sub,
-                           f"unexpected SDO response {data.hex(' ')}")
+            raise SdoError(transfer.node, transfer.index, transfer.sub, f"unexpected SDO response {data.hex(' ')}")
 
     def _abort(self, transfer: _Transfer, code: int) -> None:
         try:
@@ -400,9 +470,15 @@ class SdoEngine:
                     self._abort(transfer, ABORT_TIMEOUT)
                 transfer.completion.drive_silent()
                 sent = " (request sent twice)" if transfer.repeated else ""
-                self._finish(transfer, SdoTimeoutError(
-                    transfer.node, transfer.index, transfer.sub,
-                    f"no SDO response within {transfer.timeout * 1000:.0f} ms on bus {self.link.name}{sent}"))
+                self._finish(
+                    transfer,
+                    SdoTimeoutError(
+                        transfer.node,
+                        transfer.index,
+                        transfer.sub,
+                        f"no SDO response within {transfer.timeout * 1000:.0f} ms on bus {self.link.name}{sent}",
+                    ),
+                )
                 self._start_next(transfer.node)
         self._hand_over()
 
@@ -416,6 +492,12 @@ class SdoEngine:
                 queue.clear()
             self._active.clear()
             for transfer in pending:
-                self._finished.append((transfer, SdoLinkError(
-                    transfer.node, transfer.index, transfer.sub, f"bus {self.link.name} lost: {reason}")))
+                self._finished.append(
+                    (
+                        transfer,
+                        SdoLinkError(
+                            transfer.node, transfer.index, transfer.sub, f"bus {self.link.name} lost: {reason}"
+                        ),
+                    )
+                )
         self._hand_over()

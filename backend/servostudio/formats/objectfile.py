@@ -16,8 +16,8 @@ from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from servostudio.formats.textfile import FILE_ENCODING, split_lines, write_text_atomic
 from servostudio.formats.numbers import parse_integer
+from servostudio.formats.textfile import FILE_ENCODING, split_lines, write_text_atomic
 
 MAX_INDEX = 0xFFFF
 MAX_SUB = 0xFF
@@ -52,8 +52,7 @@ class ObjectFileError(ValueError):
         self.reason = reason
 
 
-def parse_object_file(text: str, file: str = "<string>",
-                      validate: EntryValidator | None = None) -> list[ObjectEntry]:
+def parse_object_file(text: str, file: str = "<string>", validate: EntryValidator | None = None) -> list[ObjectEntry]:
     """Parse object-file text into its entries, in file order; raise ObjectFileError on the first bad line."""
     entries: list[ObjectEntry] = []
     first_line: dict[tuple[int, int], int] = {}
@@ -66,8 +65,9 @@ def parse_object_file(text: str, file: str = "<string>",
             raise ObjectFileError(file, number, str(error)) from None
         key = (entry.index, entry.sub)
         if key in first_line:
-            raise ObjectFileError(file, number, f"duplicate assignment of {_key_text(*key)} "
-                                                f"(first at line {first_line[key]})")
+            raise ObjectFileError(
+                file, number, f"duplicate assignment of {_key_text(*key)} (first at line {first_line[key]})"
+            )
         first_line[key] = number
         reason = validate(entry) if validate is not None else None
         if reason is not None:
@@ -98,8 +98,7 @@ def format_object_file(entries: Iterable[ObjectEntry], header: str | None = None
     return "".join(line + "\n" for line in lines)
 
 
-def write_object_file(path: str | os.PathLike[str], entries: Iterable[ObjectEntry],
-                      header: str | None = None) -> None:
+def write_object_file(path: str | os.PathLike[str], entries: Iterable[ObjectEntry], header: str | None = None) -> None:
     """Write entries in canonical form, atomically (the old file stays intact if anything fails)."""
     write_text_atomic(path, format_object_file(entries, header))
 

@@ -44,8 +44,10 @@ class BitPattern:
     def __post_init__(self) -> None:
         limit = 1 << PATTERN_WIDTH
         if not (0 <= self.zeros < limit and 0 <= self.ones < limit):
-            raise ValueError(f"pattern bits must be within bits 0..{PATTERN_WIDTH - 1} "
-                             f"(zeros=0x{self.zeros:X}, ones=0x{self.ones:X})")
+            raise ValueError(
+                f"pattern bits must be within bits 0..{PATTERN_WIDTH - 1} "
+                f"(zeros=0x{self.zeros:X}, ones=0x{self.ones:X})"
+            )
         if self.zeros & self.ones:
             raise ValueError(f"pattern bits 0x{self.zeros & self.ones:X} cannot be both 0 and 1")
 
@@ -54,16 +56,22 @@ class BitPattern:
         """Parse the quoted file form; ValueError says what a pattern must look like."""
         match = _PATTERN.fullmatch(text.strip())
         if match is None:
-            raise ValueError(f'a pattern is 8 characters of 1, 0 or . in double quotes, MSB first '
-                             f'(e.g. "..001000"), got {text.strip()!r}')
+            raise ValueError(
+                f"a pattern is 8 characters of 1, 0 or . in double quotes, MSB first "
+                f'(e.g. "..001000"), got {text.strip()!r}'
+            )
         chars = match.group(1)
         bits = {position: chars[PATTERN_WIDTH - 1 - position] for position in range(PATTERN_WIDTH)}
-        return cls(zeros=sum(1 << bit for bit, char in bits.items() if char == "0"),
-                   ones=sum(1 << bit for bit, char in bits.items() if char == "1"))
+        return cls(
+            zeros=sum(1 << bit for bit, char in bits.items() if char == "0"),
+            ones=sum(1 << bit for bit, char in bits.items() if char == "1"),
+        )
 
     def __str__(self) -> str:
-        chars = ["1" if self.ones >> bit & 1 else "0" if self.zeros >> bit & 1 else "."
-                 for bit in reversed(range(PATTERN_WIDTH))]
+        chars = [
+            "1" if self.ones >> bit & 1 else "0" if self.zeros >> bit & 1 else "."
+            for bit in reversed(range(PATTERN_WIDTH))
+        ]
         return '"' + "".join(chars) + '"'
 
 
@@ -87,8 +95,10 @@ def value_problem(keyword: Keyword, value: Value) -> str | None:
         return f"{value} has no constant; allowed: {', '.join(keyword.constants)}"
     sub = keyword.sub
     unit = f", {sub.unit}" if sub.unit else ""
-    return (f"value {value} is out of range: allowed {keyword.value_range} "
-            f"(0x{SEQUENCE_PARAMETERS_INDEX:04X},{sub.sub} {sub.name}: {sub.data_type}{unit})")
+    return (
+        f"value {value} is out of range: allowed {keyword.value_range} "
+        f"(0x{SEQUENCE_PARAMETERS_INDEX:04X},{sub.sub} {sub.name}: {sub.data_type}{unit})"
+    )
 
 
 @dataclass(frozen=True)
@@ -152,6 +162,7 @@ class Sequence:
         cannot say (cam type, toggled outputs, INPOS or combined triggers, the homing return option, pattern
         bits above bit 7, values out of range), because such a sequence could not be saved to a file.
         """
+
         def sub_value(sub: int) -> int:
             return record.get(sub, SUBS[sub].default)
 
@@ -166,8 +177,10 @@ class Sequence:
             raise ValueError(f"sequence type {type_value} is not one of 0..6") from None
         for sub in UNREACHABLE_SUBS[kind]:
             if sub_value(sub) != SUBS[sub].default:
-                raise ValueError(f"0x3611,{sub} ({SUBS[sub].name}) = {sub_value(sub)} in a {kind.name} sequence "
-                                 f"has no SEQUENCE.TXT keyword")
+                raise ValueError(
+                    f"0x3611,{sub} ({SUBS[sub].name}) = {sub_value(sub)} in a {kind.name} sequence "
+                    f"has no SEQUENCE.TXT keyword"
+                )
         values: dict[str, Value] = {}
         for keyword in keywords_for(kind):
             if keyword.is_pattern:

@@ -99,7 +99,7 @@ class _Block:
 class _Reader:
     def __init__(self, max_sequences: int) -> None:
         self.max_sequences = max_sequences
-        self.issues: dict[SequenceIssue, None] = {}     # an ordered set: a default may fail the same way twice
+        self.issues: dict[SequenceIssue, None] = {}  # an ordered set: a default may fail the same way twice
         self.defaults: list[_Assignment] = []
         self.blocks: list[_Block] = []
         self.declared_at: dict[int, int] = {}
@@ -132,15 +132,22 @@ class _Reader:
         self.in_default = False
         number = parse_integer(assignment.text)
         if number is None:
-            self.report(assignment.line, assignment.key,
-                        f"{assignment.text!r} is not a sequence number (decimal or 0x hex)")
+            self.report(
+                assignment.line, assignment.key, f"{assignment.text!r} is not a sequence number (decimal or 0x hex)"
+            )
         elif not 0 <= number < self.max_sequences:
-            self.report(assignment.line, assignment.key,
-                        f"sequence number {number} is out of range: allowed 0..{self.max_sequences - 1}")
+            self.report(
+                assignment.line,
+                assignment.key,
+                f"sequence number {number} is out of range: allowed 0..{self.max_sequences - 1}",
+            )
             number = None
         elif number in self.declared_at:
-            self.report(assignment.line, assignment.key,
-                        f"sequence {number} is already declared at line {self.declared_at[number]}")
+            self.report(
+                assignment.line,
+                assignment.key,
+                f"sequence {number} is already declared at line {self.declared_at[number]}",
+            )
             number = None
         else:
             self.declared_at[number] = assignment.line
@@ -197,8 +204,11 @@ class _Reader:
             if keyword is None:
                 self.report_misplaced(assignment, kind)
             elif keyword.name in declared_at:
-                self.report(assignment.line, assignment.key, f"{keyword.name} is declared twice in {label} "
-                                                             f"(first at line {declared_at[keyword.name]})")
+                self.report(
+                    assignment.line,
+                    assignment.key,
+                    f"{keyword.name} is declared twice in {label} (first at line {declared_at[keyword.name]})",
+                )
             else:
                 declared_at[keyword.name] = assignment.line
                 value = self.parse(assignment, keyword, context=f"[{label}]")
@@ -221,8 +231,11 @@ class _Reader:
         defaults = [a for a in block.defaults if normalize(a.key) in SEQ_TYPE.spellings]
         source = declared[0] if declared else defaults[-1] if defaults else None
         if source is None:
-            self.report(block.line, SEQ_NB, f"sequence {_number_text(block)} has no SeqType "
-                                            f"(allowed: {', '.join(SequenceType.__members__)})")
+            self.report(
+                block.line,
+                SEQ_NB,
+                f"sequence {_number_text(block)} has no SeqType (allowed: {', '.join(SequenceType.__members__)})",
+            )
             return None
         value = self.parse(source, SEQ_TYPE)
         return SequenceType(value) if isinstance(value, int) else None
@@ -232,8 +245,9 @@ class _Reader:
             self.report(assignment.line, assignment.key, "unknown keyword")
             return
         allowed = ", ".join(keyword.name for keyword in keywords_for(kind))
-        self.report(assignment.line, assignment.key,
-                    f"not a keyword of {kind.name} sequences (allowed: SeqType, {allowed})")
+        self.report(
+            assignment.line, assignment.key, f"not a keyword of {kind.name} sequences (allowed: SeqType, {allowed})"
+        )
 
 
 def _number_text(block: _Block) -> str:

@@ -76,40 +76,46 @@ class SubIndex:
     unit: str = ""
 
 
-SUBS: Mapping[int, SubIndex] = MappingProxyType({entry.sub: entry for entry in (
-    SubIndex(1, "Sequence Type", "Integer16", span(0, 6)),
-    SubIndex(2, "Next sequence", "Integer16", span(-1, 127), default=-1),
-    SubIndex(3, "Sequence Counter", "Unsigned16", U16),
-    SubIndex(4, "Sequence Link", "Integer16", span(-1, 127), default=-1),
-    SubIndex(5, "Output Trigger", "Unsigned16", U16),
-    SubIndex(6, "Output Bits = 0", "Unsigned16", U16),
-    SubIndex(7, "Output Bits = 1", "Unsigned16", U16),
-    SubIndex(8, "Output Bits Toggle", "Unsigned16", U16),
-    SubIndex(9, "Start Condition Bits = 0", "Unsigned16", U16),
-    SubIndex(10, "Start Condition Bits = 1", "Unsigned16", U16),
-    SubIndex(11, "End Condition Bits = 0", "Unsigned16", U16),
-    SubIndex(12, "End Condition Bits = 1", "Unsigned16", U16),
-    SubIndex(13, "Position", "Integer32", I32, unit="position unit"),
-    SubIndex(14, "Position 2", "Integer32", I32, unit="position unit"),
-    SubIndex(15, "Speed", "Integer32", I32, unit="speed unit"),
-    SubIndex(16, "Speed 2 / Position 3", "Integer32", I32, unit="speed or position unit"),
-    SubIndex(17, "Acceleration", "Unsigned32", U32, unit="acceleration unit"),
-    SubIndex(18, "Deceleration", "Unsigned32", U32, unit="acceleration unit"),
-    SubIndex(19, "Acceleration Time", "Unsigned16", span(1, 0xFFFF), unit="ms"),
-    SubIndex(20, "Deceleration Time", "Unsigned16", span(0, 0xFFFF), unit="ms"),
-    SubIndex(21, "Configuration", "Unsigned16", U16),
-    SubIndex(22, "Configuration 2", "Integer16", I16),
-    SubIndex(23, "Temporization", "Unsigned16", span(0, 16000), unit="ms"),
-    SubIndex(24, "Running Time", "Unsigned16", U16, unit="ms, 65535 = infinite"),
-    SubIndex(25, "Analog In", "Integer16", I16, unit="per mille of rated current"),
-    SubIndex(26, "Analog In 2", "Integer16", I16),
-)})
+SUBS: Mapping[int, SubIndex] = MappingProxyType(
+    {
+        entry.sub: entry
+        for entry in (
+            SubIndex(1, "Sequence Type", "Integer16", span(0, 6)),
+            SubIndex(2, "Next sequence", "Integer16", span(-1, 127), default=-1),
+            SubIndex(3, "Sequence Counter", "Unsigned16", U16),
+            SubIndex(4, "Sequence Link", "Integer16", span(-1, 127), default=-1),
+            SubIndex(5, "Output Trigger", "Unsigned16", U16),
+            SubIndex(6, "Output Bits = 0", "Unsigned16", U16),
+            SubIndex(7, "Output Bits = 1", "Unsigned16", U16),
+            SubIndex(8, "Output Bits Toggle", "Unsigned16", U16),
+            SubIndex(9, "Start Condition Bits = 0", "Unsigned16", U16),
+            SubIndex(10, "Start Condition Bits = 1", "Unsigned16", U16),
+            SubIndex(11, "End Condition Bits = 0", "Unsigned16", U16),
+            SubIndex(12, "End Condition Bits = 1", "Unsigned16", U16),
+            SubIndex(13, "Position", "Integer32", I32, unit="position unit"),
+            SubIndex(14, "Position 2", "Integer32", I32, unit="position unit"),
+            SubIndex(15, "Speed", "Integer32", I32, unit="speed unit"),
+            SubIndex(16, "Speed 2 / Position 3", "Integer32", I32, unit="speed or position unit"),
+            SubIndex(17, "Acceleration", "Unsigned32", U32, unit="acceleration unit"),
+            SubIndex(18, "Deceleration", "Unsigned32", U32, unit="acceleration unit"),
+            SubIndex(19, "Acceleration Time", "Unsigned16", span(1, 0xFFFF), unit="ms"),
+            SubIndex(20, "Deceleration Time", "Unsigned16", span(0, 0xFFFF), unit="ms"),
+            SubIndex(21, "Configuration", "Unsigned16", U16),
+            SubIndex(22, "Configuration 2", "Integer16", I16),
+            SubIndex(23, "Temporization", "Unsigned16", span(0, 16000), unit="ms"),
+            SubIndex(24, "Running Time", "Unsigned16", U16, unit="ms, 65535 = infinite"),
+            SubIndex(25, "Analog In", "Integer16", I16, unit="per mille of rated current"),
+            SubIndex(26, "Analog In 2", "Integer16", I16),
+        )
+    }
+)
 
 #: Homing methods of the drive (0x6098, manual L8921–8974).
 HOMING_METHODS = ValueRange(((-4, -1), (1, 14), (17, 30), (33, 35)))
 
 TRIGGERS: Mapping[str, int] = MappingProxyType(
-    {"BEGIN": 1 << 0, "CRUISE": 1 << 1, "DECEL": 1 << 2, "HOLD": 1 << 3, "END": 1 << 5})
+    {"BEGIN": 1 << 0, "CRUISE": 1 << 1, "DECEL": 1 << 2, "HOLD": 1 << 3, "END": 1 << 5}
+)
 POSITIONING_TYPES: Mapping[str, int] = MappingProxyType({"ABS": 0, "REL": 1})
 SEQUENCE_TYPES: Mapping[str, int] = MappingProxyType({member.name: member.value for member in SequenceType})
 
@@ -184,40 +190,48 @@ COMMON: tuple[Keyword, ...] = (
 )
 
 #: Type-specific keywords, in the order of the manual's keyword list (which the writer follows).
-SPECIFIC: Mapping[SequenceType, tuple[Keyword, ...]] = MappingProxyType({
-    SequenceType.POS: (
-        Keyword("PosType", (21,), constants=POSITIONING_TYPES),
-        Keyword("Pos", (13,), aliases=("Position",)),
-        SPEED, SPEED2,
-        Keyword("Accel", (17,), aliases=("AccelTime",)),
-        Keyword("Decel", (18,), aliases=("DecelTime",)),
-    ),
-    SequenceType.HOME: (
-        Keyword("HomeOfs", (13,), aliases=("Home offset",)),
-        SPEED, SPEED2, ACCEL_MS, DECEL_MS,
-        Keyword("Method", (22,), allowed=HOMING_METHODS),
-        TORQUE_LIMIT,
-    ),
-    SequenceType.SPEED: (
-        SPEED,
-        Keyword("AccelTime", (19,), aliases=("Accel",)),
-        Keyword("DecelTime", (20,), aliases=("Decel",)),
-        RUN_TIME,
-    ),
-    SequenceType.TORQUE: (SPEED, ACCEL_MS, DECEL_MS, RUN_TIME, TORQUE_LIMIT),
-    SequenceType.GEAR: (
-        Keyword("Config", (21,)),
-        Keyword("Factor", (26,)),
-        SPEED, ACCEL_MS,
-        Keyword("MasterDtn", (13,)),
-        Keyword("SlaveDtn", (14,)),
-        Keyword("SyncDtn", (16,)),
-    ),
-})
+SPECIFIC: Mapping[SequenceType, tuple[Keyword, ...]] = MappingProxyType(
+    {
+        SequenceType.POS: (
+            Keyword("PosType", (21,), constants=POSITIONING_TYPES),
+            Keyword("Pos", (13,), aliases=("Position",)),
+            SPEED,
+            SPEED2,
+            Keyword("Accel", (17,), aliases=("AccelTime",)),
+            Keyword("Decel", (18,), aliases=("DecelTime",)),
+        ),
+        SequenceType.HOME: (
+            Keyword("HomeOfs", (13,), aliases=("Home offset",)),
+            SPEED,
+            SPEED2,
+            ACCEL_MS,
+            DECEL_MS,
+            Keyword("Method", (22,), allowed=HOMING_METHODS),
+            TORQUE_LIMIT,
+        ),
+        SequenceType.SPEED: (
+            SPEED,
+            Keyword("AccelTime", (19,), aliases=("Accel",)),
+            Keyword("DecelTime", (20,), aliases=("Decel",)),
+            RUN_TIME,
+        ),
+        SequenceType.TORQUE: (SPEED, ACCEL_MS, DECEL_MS, RUN_TIME, TORQUE_LIMIT),
+        SequenceType.GEAR: (
+            Keyword("Config", (21,)),
+            Keyword("Factor", (26,)),
+            SPEED,
+            ACCEL_MS,
+            Keyword("MasterDtn", (13,)),
+            Keyword("SlaveDtn", (14,)),
+            Keyword("SyncDtn", (16,)),
+        ),
+    }
+)
 
 #: Subs a type gives a meaning to that no keyword can set; they must stay at their default (0).
-UNREACHABLE_SUBS: Mapping[SequenceType, tuple[int, ...]] = MappingProxyType({
-    kind: ((8, 21) if kind is SequenceType.HOME else (8,)) for kind in SequenceType})
+UNREACHABLE_SUBS: Mapping[SequenceType, tuple[int, ...]] = MappingProxyType(
+    {kind: ((8, 21) if kind is SequenceType.HOME else (8,)) for kind in SequenceType}
+)
 
 
 def keywords_for(kind: SequenceType) -> tuple[Keyword, ...]:
@@ -225,9 +239,12 @@ def keywords_for(kind: SequenceType) -> tuple[Keyword, ...]:
     return SPECIFIC[kind] + COMMON
 
 
-_BY_SPELLING: Mapping[SequenceType, Mapping[str, Keyword]] = MappingProxyType({
-    kind: {spelling: keyword for keyword in keywords_for(kind) for spelling in keyword.spellings}
-    for kind in SequenceType})
+_BY_SPELLING: Mapping[SequenceType, Mapping[str, Keyword]] = MappingProxyType(
+    {
+        kind: {spelling: keyword for keyword in keywords_for(kind) for spelling in keyword.spellings}
+        for kind in SequenceType
+    }
+)
 
 
 def find_keyword(kind: SequenceType, spelling: str) -> Keyword | None:

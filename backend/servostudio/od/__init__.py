@@ -6,7 +6,6 @@ See docs/eds.md for the file formats.
 from servostudio.od.datatypes import DataType, EncodingError, decode, encode
 from servostudio.od.eds import load_dictionary
 from servostudio.od.library import BUILTIN_EDS_DIR, EdsLibrary, LibraryError, builtin_library
-from servostudio.od.pointer import Pointer
 from servostudio.od.model import (
     Access,
     BitField,
@@ -19,6 +18,7 @@ from servostudio.od.model import (
     Variable,
     WrongType,
 )
+from servostudio.od.pointer import Pointer
 
 __all__ = [
     "BUILTIN_EDS_DIR",

@@ -11,6 +11,7 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 
 from servostudio.od.datatypes import DataType
+from servostudio.od.eds_values import ValueSyntaxError, parse_integer, parse_value
 from servostudio.od.ini import IniFile, IniSection, read_ini
 from servostudio.od.model import (
     Access,
@@ -21,7 +22,6 @@ from servostudio.od.model import (
     Variable,
 )
 from servostudio.od.props import apply_props
-from servostudio.od.values import ValueSyntaxError, parse_integer, parse_value
 
 _OBJECT_SECTION = re.compile(r"^[0-9A-F]{4}$", re.IGNORECASE)
 _SUB_SECTION = re.compile(r"^(?P<index>[0-9A-F]{4})sub(?P<sub>[0-9A-F]{1,2})$", re.IGNORECASE)
@@ -33,9 +33,22 @@ _MANDATORY = (0x1000, 0x1001, 0x1018)
 _OBJECT_KEYS = frozenset(
     key.lower()
     for key in (
-        "ParameterName", "ObjectType", "DataType", "AccessType", "DefaultValue", "PDOMapping", "LowLimit",
-        "HighLimit", "SubNumber", "CompactSubObj", "ObjFlags", "ParameterValue", "Denotation", "UploadFile",
-        "DownloadFile", "ParamRefd",
+        "ParameterName",
+        "ObjectType",
+        "DataType",
+        "AccessType",
+        "DefaultValue",
+        "PDOMapping",
+        "LowLimit",
+        "HighLimit",
+        "SubNumber",
+        "CompactSubObj",
+        "ObjFlags",
+        "ParameterValue",
+        "Denotation",
+        "UploadFile",
+        "DownloadFile",
+        "ParamRefd",
     )
 )
 _OBJECT_TYPES = {0x2: ObjectKind.VAR, 0x7: ObjectKind.VAR, 0x8: ObjectKind.ARRAY, 0x9: ObjectKind.RECORD}
@@ -245,8 +258,14 @@ class _EdsReader:
         names = self._compact_names(index, count)
         subs = {
             0: Variable(
-                index=index, subindex=0, name="NrOfObjects", data_type=DataType.UNSIGNED8, access=Access.RO,
-                default=count, default_expr=str(count), parent_name=name,
+                index=index,
+                subindex=0,
+                name="NrOfObjects",
+                data_type=DataType.UNSIGNED8,
+                access=Access.RO,
+                default=count,
+                default_expr=str(count),
+                parent_name=name,
             )
         }
         template = self._variable(section, index, 1, name)
@@ -288,9 +307,18 @@ class _EdsReader:
         default, uses_node_id, expr = self._default(section, data_type, low, high, "DefaultValue")
         self._default(section, data_type, low, high, "ParameterValue")  # a DCF value must be valid too
         return Variable(
-            index=index, subindex=sub, name=name,
-            data_type=data_type, access=access, pdo_mappable=bool(pdo), low=low, high=high, default=default,
-            default_expr=expr, parent_name=parent_name, default_uses_node_id=uses_node_id,
+            index=index,
+            subindex=sub,
+            name=name,
+            data_type=data_type,
+            access=access,
+            pdo_mappable=bool(pdo),
+            low=low,
+            high=high,
+            default=default,
+            default_expr=expr,
+            parent_name=parent_name,
+            default_uses_node_id=uses_node_id,
         )
 
     def _name(self, section: IniSection) -> str:
@@ -366,7 +394,8 @@ class _EdsReader:
             return
         if not data_type.min_value <= value <= data_type.max_value:
             raise self.error(
-                section, section.line_of(key),
+                section,
+                section.line_of(key),
                 f"{key} {value} is outside the {data_type.name} range {data_type.min_value}..{data_type.max_value}",
             )
 

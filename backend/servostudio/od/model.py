@@ -198,7 +198,7 @@ _ADDRESS = re.compile(
 
 
 def _parse_address(text: str) -> tuple[int, int] | None:
-    """"0x6041" -> (0x6041, 0); "60F9,2" and "60F9:2" take a decimal (or 0x-prefixed) sub; "60F9sub2" a hex one."""
+    """ "0x6041" -> (0x6041, 0); "60F9,2" and "60F9:2" take a decimal (or 0x-prefixed) sub; "60F9sub2" a hex one."""
     match = _ADDRESS.match(text)
     if not match:
         return None

@@ -13,9 +13,9 @@ import re
 from dataclasses import dataclass, field, replace
 
 from servostudio.od.datatypes import DataType
+from servostudio.od.eds_values import ValueSyntaxError, parse_integer
 from servostudio.od.ini import IniFile, IniSection
 from servostudio.od.model import BitField, DictionaryError, DictObject, ObjectKind, SaveType, Variable
-from servostudio.od.values import ValueSyntaxError, parse_integer
 
 _OBJECT = re.compile(r"^(?P<index>[0-9A-F]{4})(?:sub(?P<sub>[0-9A-F]{1,2}))?$", re.IGNORECASE)
 _ENUM = re.compile(r"^enum\.(?P<value>.+)$", re.IGNORECASE)
@@ -180,8 +180,10 @@ def _check_enum(ini: IniFile, var: Variable, props: _Props) -> None:
         if not var.data_type.is_integer or not var.data_type.min_value <= value <= var.data_type.max_value:
             line = next(e.line for e in props.section if _ENUM.match(e.key) and _enum_value(e.key) == value)
             raise DictionaryError(
-                ini.path, line, props.section.name, f"Enum value {value} does not fit 0x{var.index:04X},{var.subindex} "
-                f"({var.data_type.name})",
+                ini.path,
+                line,
+                props.section.name,
+                f"Enum value {value} does not fit 0x{var.index:04X},{var.subindex} ({var.data_type.name})",
             )
 
 
@@ -197,6 +199,8 @@ def _check_bits(ini: IniFile, var: Variable, props: _Props) -> None:
     for bit_field, line in props.bits:
         if width is None or bit_field.last >= width:
             raise DictionaryError(
-                ini.path, line, props.section.name, f"bit {bit_field.last} does not exist in 0x{var.index:04X},"
-                f"{var.subindex} ({var.data_type.name})",
+                ini.path,
+                line,
+                props.section.name,
+                f"bit {bit_field.last} does not exist in 0x{var.index:04X},{var.subindex} ({var.data_type.name})",
             )

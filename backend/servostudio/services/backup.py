@@ -27,8 +27,8 @@ from pathlib import Path
 
 from servostudio.drive.access import Drive, DriveAccessError
 from servostudio.drive.cia402 import State, decode_state
+from servostudio.drive.object_values import ObjectValue
 from servostudio.drive.sdo import SdoAbortError, SdoError, TransferBatch
-from servostudio.drive.values import ObjectValue
 from servostudio.formats.objectfile import ObjectEntry, ObjectFileError, read_object_file, write_object_file
 from servostudio.formats.sequence import SequenceFileError, SequenceTable, read_sequence_file, write_sequence_file
 from servostudio.od.datatypes import DataType
@@ -77,8 +77,14 @@ class BackupResult:
     seconds: float = 0.0
 
     def as_dict(self) -> dict[str, object]:
-        return {"node": self.node, "file": self.file, "kind": self.kind, "objects": self.objects,
-                "skipped": self.skipped, "seconds": round(self.seconds, 3)}
+        return {
+            "node": self.node,
+            "file": self.file,
+            "kind": self.kind,
+            "objects": self.objects,
+            "skipped": self.skipped,
+            "seconds": round(self.seconds, 3),
+        }
 
 
 @dataclass
@@ -108,10 +114,18 @@ class RestoreResult:
         counts: dict[str, int] = {}
         for outcome in self.outcomes:
             counts[outcome.status] = counts.get(outcome.status, 0) + 1
-        return {"node": self.node, "file": self.file, "kind": self.kind, "ok": self.ok, "counts": counts,
-                "stored": self.stored, "error": self.error or None, "seconds": round(self.seconds, 3),
-                "cancelled": self.cancelled,
-                "objects": [outcome.__dict__ for outcome in self.outcomes if outcome.status != "verified"]}
+        return {
+            "node": self.node,
+            "file": self.file,
+            "kind": self.kind,
+            "ok": self.ok,
+            "counts": counts,
+            "stored": self.stored,
+            "error": self.error or None,
+            "seconds": round(self.seconds, 3),
+            "cancelled": self.cancelled,
+            "objects": [outcome.__dict__ for outcome in self.outcomes if outcome.status != "verified"],
+        }
 
 
 # ---------------------------------------------------------------------------------------------------- backup --
@@ -119,13 +133,23 @@ def backup_objects(drive: Drive, save_type: SaveType) -> list[Variable]:
     """Objects of a save type that a restore can write back (readable and writable)."""
     if drive.dictionary is None:
         raise BackupError(f"node {drive.node}: no object dictionary known for this drive; scan the bus first")
-    return [var for var in drive.dictionary.variables()
-            if var.save_type is save_type and var.access.readable and var.access.writable
-            and var.data_type not in (DataType.DOMAIN, DataType.OCTET_STRING)]
+    return [
+        var
+        for var in drive.dictionary.variables()
+        if var.save_type is save_type
+        and var.access.readable
+        and var.access.writable
+        and var.data_type not in (DataType.DOMAIN, DataType.OCTET_STRING)
+    ]
 
 
-def backup_file(drive: Drive, path: Path, kind: FileKind | None = None,
-                progress: Progress | None = None, cancel: Cancellation | None = None) -> BackupResult:
+def backup_file(
+    drive: Drive,
+    path: Path,
+    kind: FileKind | None = None,
+    progress: Progress | None = None,
+    cancel: Cancellation | None = None,
+) -> BackupResult:
     """Back up one file of one drive; the file is written atomically at the end (not at all when cancelled:
     raises Cancelled)."""
     kind = kind or FileKind.from_path(path)
@@ -142,21 +166,30 @@ def backup_file(drive: Drive, path: Path, kind: FileKind | None = None,
     for value in values:
         file_value = _file_value(value)
         if isinstance(file_value, str) and _unwritable_text(file_value):
-            skipped.append({"object": value.variable.label, "reason": f"text {file_value!r} has no object-file syntax "
-                            "(empty, padded, numeric-looking or with ';')"})
+            skipped.append(
+                {
+                    "object": value.variable.label,
+                    "reason": f"text {file_value!r} has no object-file syntax "
+                    "(empty, padded, numeric-looking or with ';')",
+                }
+            )
             continue
         entries.append(ObjectEntry(value.variable.index, value.variable.subindex, file_value))
     write_object_file(path, entries, header=_header(drive, kind))
     return BackupResult(drive.node, str(path), kind.value, len(entries), skipped, time.monotonic() - started)
 
 
-def _read_all(drive: Drive, variables: list[Variable], kind: FileKind, progress: Progress | None,
-              cancel: Cancellation | None = None) -> tuple[list[ObjectValue], list[dict[str, str]]]:
+def _read_all(
+    drive: Drive,
+    variables: list[Variable],
+    kind: FileKind,
+    progress: Progress | None,
+    cancel: Cancellation | None = None,
+) -> tuple[list[ObjectValue], list[dict[str, str]]]:
     """Read every object in one batch (the engine sends them back to back); this thread waits once, and a
     cancellation drops the reads not yet sent."""
     reporter = _Reporter(progress, "backup", drive.node, kind.value, len(variables))
-    outcomes = _wait_batch(drive.submit_read_all(variables, on_each=lambda position, outcome: reporter.step()),
-                           cancel)
+    outcomes = _wait_batch(drive.submit_read_all(variables, on_each=lambda position, outcome: reporter.step()), cancel)
     if cancel is not None and cancel.requested:
         raise Cancelled(f"backup of node {drive.node} ({kind.value}) cancelled, no file written")
     values, skipped = [], []
@@ -198,8 +231,7 @@ def _file_value(value: ObjectValue) -> int | str:
 
 def _unwritable_text(text: str) -> bool:
     """The object file cannot spell empty or padded text, text that starts like a number, or ';' and line breaks."""
-    return (not text or text != text.strip() or text[0] in "+-0123456789"
-            or any(char in text for char in ";\r\n"))
+    return not text or text != text.strip() or text[0] in "+-0123456789" or any(char in text for char in ";\r\n")
 
 
 def _header(drive: Drive, kind: FileKind) -> str:
@@ -207,8 +239,13 @@ def _header(drive: Drive, kind: FileKind) -> str:
     return f"{kind.value} of node {drive.node} ({device}), Servo Studio backup {time.strftime('%Y-%m-%d %H:%M:%S')}"
 
 
-def backup_drive(drive: Drive, directory: Path, kinds: Iterable[FileKind] | None = None,
-                 progress: Progress | None = None, cancel: Cancellation | None = None) -> list[BackupResult]:
+def backup_drive(
+    drive: Drive,
+    directory: Path,
+    kinds: Iterable[FileKind] | None = None,
+    progress: Progress | None = None,
+    cancel: Cancellation | None = None,
+) -> list[BackupResult]:
     """All backup files of a drive into ``directory`` (the profile's parameter files, plus SEQUENCE.TXT).
 
     When cancelled, the files completed so far are returned (``cancel.requested`` tells the caller)."""
@@ -277,8 +314,14 @@ def _entry_value(variable: Variable, value: int | str) -> int | float | str:
     return value
 
 
-def restore_file(drive: Drive, path: Path, kind: FileKind | None = None, progress: Progress | None = None,
-                 store: bool = True, cancel: Cancellation | None = None) -> RestoreResult:
+def restore_file(
+    drive: Drive,
+    path: Path,
+    kind: FileKind | None = None,
+    progress: Progress | None = None,
+    store: bool = True,
+    cancel: Cancellation | None = None,
+) -> RestoreResult:
     """Validate, write, verify and store one file to one drive.
 
     A cancellation drops the writes not yet sent: the result lists which objects were written (not verified, not
@@ -293,8 +336,13 @@ def restore_file(drive: Drive, path: Path, kind: FileKind | None = None, progres
     _check_can_store(drive, store)
     if cancel is not None and cancel.requested:
         result.outcomes = [ObjectOutcome(var.label, _shown(value), "not written") for var, value in writes]
-        result.error, result.cancelled = (f"restore of node {drive.node} cancelled: 0 of {len(writes)} objects were "
-                                          "written; nothing was stored to flash"), True
+        result.error, result.cancelled = (
+            (
+                f"restore of node {drive.node} cancelled: 0 of {len(writes)} objects were "
+                "written; nothing was stored to flash"
+            ),
+            True,
+        )
         return result
     try:
         if kind is FileKind.SEQUENCE:
@@ -317,26 +365,38 @@ def _check_can_store(drive: Drive, store: bool) -> None:
     if store and drive.profile.save_needs_disabled:
         state = decode_state(int(drive.read("statusword").raw))
         if state is State.OPERATION_ENABLED:
-            raise BackupError(f"node {drive.node}: {drive.profile.device} stores parameters only with the drive "
-                              "disabled; disable it first — nothing was written")
+            raise BackupError(
+                f"node {drive.node}: {drive.profile.device} stores parameters only with the drive "
+                "disabled; disable it first — nothing was written"
+            )
 
 
-def _write_and_verify(drive: Drive, writes: list[tuple[Variable, object]], kind: FileKind,
-                      progress: Progress | None, report: list[ObjectOutcome],
-                      cancel: Cancellation | None = None) -> None:
+def _write_and_verify(
+    drive: Drive,
+    writes: list[tuple[Variable, object]],
+    kind: FileKind,
+    progress: Progress | None,
+    report: list[ObjectOutcome],
+    cancel: Cancellation | None = None,
+) -> None:
     """Write all, read all back; rewrite what a later write changed (side effects), read back once more.
 
     ``report`` receives one outcome per object up front and is updated as answers arrive, so after a failure it
     says exactly which objects were written.
     """
-    outcomes = {index: ObjectOutcome(var.label, _shown(value), "not written")
-                for index, (var, value) in enumerate(writes)}
+    outcomes = {
+        index: ObjectOutcome(var.label, _shown(value), "not written") for index, (var, value) in enumerate(writes)
+    }
     report.extend(outcomes.values())
     reporter = _Reporter(progress, "restore", drive.node, kind.value, 2 * len(writes))
     pending = list(range(len(writes)))
     for _ in range(2):  # one rewrite pass for values that a later write changed
-        written = _wait_batch(drive.submit_write_all([writes[index] for index in pending],
-                                                     on_each=lambda position, outcome: reporter.step()), cancel)
+        written = _wait_batch(
+            drive.submit_write_all(
+                [writes[index] for index in pending], on_each=lambda position, outcome: reporter.step()
+            ),
+            cancel,
+        )
         link_error: SdoError | None = None
         for index, outcome in zip(pending, written):
             if isinstance(outcome, CancelledError):
@@ -353,10 +413,15 @@ def _write_and_verify(drive: Drive, writes: list[tuple[Variable, object]], kind:
             raise _partial(drive, outcomes, link_error)
         if cancel is not None and cancel.requested:
             raise _cancelled(drive, outcomes)
-        readable = [index for index in pending if outcomes[index].status == "written"
-                    and writes[index][0].access.readable]
-        read_back = _wait_batch(drive.submit_read_all([writes[index][0] for index in readable],
-                                                      on_each=lambda position, outcome: reporter.step()), cancel)
+        readable = [
+            index for index in pending if outcomes[index].status == "written" and writes[index][0].access.readable
+        ]
+        read_back = _wait_batch(
+            drive.submit_read_all(
+                [writes[index][0] for index in readable], on_each=lambda position, outcome: reporter.step()
+            ),
+            cancel,
+        )
         mismatched = []
         for index, outcome in zip(readable, read_back):
             if isinstance(outcome, CancelledError):
@@ -396,15 +461,19 @@ def _wait_batch(batch: TransferBatch, cancel: Cancellation | None) -> list[objec
 
 def _partial(drive: Drive, outcomes: dict[int, ObjectOutcome], error: SdoError) -> BackupError:
     written = [outcome.label for outcome in outcomes.values() if outcome.status in ("written", "verified")]
-    return BackupError(f"restore of node {drive.node} stopped: {error}. {len(written)} of {len(outcomes)} objects "
-                       "had been written; nothing was stored to flash. Run the restore again once the link is back.")
+    return BackupError(
+        f"restore of node {drive.node} stopped: {error}. {len(written)} of {len(outcomes)} objects "
+        "had been written; nothing was stored to flash. Run the restore again once the link is back."
+    )
 
 
 def _cancelled(drive: Drive, outcomes: dict[int, ObjectOutcome]) -> Cancelled:
     sent = [outcome for outcome in outcomes.values() if outcome.status != "not written"]
     refused = [outcome for outcome in sent if outcome.status == "failed" and not outcome.error.startswith("read back")]
-    return Cancelled(f"restore of node {drive.node} cancelled: {len(sent) - len(refused)} of {len(outcomes)} "
-                     f"objects were written ({len(refused)} refused, the rest not sent); nothing was stored to flash")
+    return Cancelled(
+        f"restore of node {drive.node} cancelled: {len(sent) - len(refused)} of {len(outcomes)} "
+        f"objects were written ({len(refused)} refused, the rest not sent); nothing was stored to flash"
+    )
 
 
 def _same(read: object, written: object) -> bool:
@@ -435,8 +504,10 @@ def _read_sequences(drive: Drive, progress: Progress | None) -> SequenceTable:
         for number in used:
             drive.submit_write(number_var, number)
             records[number] = {sub: drive.submit_read(drive.variable((0x3611, sub))) for sub in subs}
-        values = {number: {sub: int(future.result().raw) for sub, future in record.items()}
-                  for number, record in records.items()}
+        values = {
+            number: {sub: int(future.result().raw) for sub, future in record.items()}
+            for number, record in records.items()
+        }
     except SdoError as error:
         raise BackupError(f"backup of node {drive.node} (SEQUENCE.TXT) stopped, no file written: {error}") from None
     reporter.finish()
@@ -464,8 +535,9 @@ def _validated_sequence_writes(drive: Drive, path: Path) -> tuple[SequenceTable,
     return table, writes
 
 
-def _write_sequences(drive: Drive, table: SequenceTable, writes: list[tuple[Variable, object]],
-                     progress: Progress | None) -> list[ObjectOutcome]:
+def _write_sequences(
+    drive: Drive, table: SequenceTable, writes: list[tuple[Variable, object]], progress: Progress | None
+) -> list[ObjectOutcome]:
     """Write the whole sequence memory (LOAD semantics), then read it back and compare sequence by sequence."""
     futures = [drive.submit_write(variable, value) for variable, value in writes]
     reporter = _Reporter(progress, "restore", drive.node, FileKind.SEQUENCE.value, len(futures))
@@ -481,8 +553,14 @@ def _write_sequences(drive: Drive, table: SequenceTable, writes: list[tuple[Vari
         wanted, found = table.sequences.get(number), memory.sequences.get(number)
         status = "verified" if wanted == found else "failed"
         held = found.type.name if found else "empty"
-        outcomes.append(ObjectOutcome(f"sequence {number}", wanted.type.name if wanted else "empty", status,
-                                      "" if status == "verified" else f"drive holds {held}"))
+        outcomes.append(
+            ObjectOutcome(
+                f"sequence {number}",
+                wanted.type.name if wanted else "empty",
+                status,
+                "" if status == "verified" else f"drive holds {held}",
+            )
+        )
     return outcomes
 
 
@@ -516,6 +594,13 @@ class _Reporter:
 
     def _emit(self) -> None:
         if self.progress is not None:
-            self.progress({"type": "progress", "operation": self.operation, "node": self.node, "file": self.file,
-                           "done": self.done, "total": self.total})
-
+            self.progress(
+                {
+                    "type": "progress",
+                    "operation": self.operation,
+                    "node": self.node,
+                    "file": self.file,
+                    "done": self.done,
+                    "total": self.total,
+                }
+            )

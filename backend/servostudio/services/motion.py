@@ -46,8 +46,10 @@ class MotionGuard:
         """`client` takes responsibility for `axis` (about to be enabled); refused without a live client."""
         with self._lock:
             if client not in self._owned:
-                raise NoLiveClient("enabling a drive needs a live client: keep /api/ws/events open and send the "
-                                   "client id it announced in the X-Servo-Client header")
+                raise NoLiveClient(
+                    "enabling a drive needs a live client: keep /api/ws/events open and send the "
+                    "client id it announced in the X-Servo-Client header"
+                )
             for axes in self._owned.values():
                 axes.discard(axis)
             self._owned[client].add(axis)

@@ -39,10 +39,14 @@ def scan(connection: BusConnection, nodes: range | list[int] | None = None) -> l
     engine = connection.engine
     present: dict[int, object] = {}
     for _ in range(PROBE_ROUNDS):  # a second round catches a node whose first answer was lost or late
-        probes = {node: engine.upload(node, 0x1000, 0, timeout=timeout, probe=True)
-                  for node in candidates if node not in present}
-        present.update({node: _value(future, DataType.UNSIGNED32) for node, future in probes.items()
-                        if _answered(future)})
+        probes = {
+            node: engine.upload(node, 0x1000, 0, timeout=timeout, probe=True)
+            for node in candidates
+            if node not in present
+        }
+        present.update(
+            {node: _value(future, DataType.UNSIGNED32) for node, future in probes.items() if _answered(future)}
+        )
     for node in [node for node in present if node > REDIRECT_OFFSET and node - REDIRECT_OFFSET in present]:
         del present[node]  # 0x600+(n+64) is node n's redirected SDO channel, not another node
     found = [_identify(connection, node, device_type) for node, device_type in sorted(present.items())]
@@ -69,8 +73,10 @@ def identify(connection: BusConnection, node: int) -> NodeInfo | None:
 
 
 def _identify(connection: BusConnection, node: int, device_type: object) -> NodeInfo:
-    requests = {name: (connection.engine.upload(node, index, sub), data_type)
-                for name, (index, sub, data_type) in _IDENTITY.items()}
+    requests = {
+        name: (connection.engine.upload(node, index, sub), data_type)
+        for name, (index, sub, data_type) in _IDENTITY.items()
+    }
     values = {name: _value(future, data_type) for name, (future, data_type) in requests.items()}
     info = NodeInfo(node=node, device_type=device_type if isinstance(device_type, int) else None, **values)
     if info.vendor_id is not None:

@@ -69,8 +69,16 @@ def sample(manager: ConnectionManager, watch: Watch, timeout: float = 2.0) -> li
     return rows
 
 
-def write(manager: ConnectionManager, motion: MotionGuard, client: str | None, bus: str, node: int, key: str,
-          value: object, physical: bool = False) -> dict[str, object]:
+def write(
+    manager: ConnectionManager,
+    motion: MotionGuard,
+    client: str | None,
+    bus: str,
+    node: int,
+    key: str,
+    value: object,
+    physical: bool = False,
+) -> dict[str, object]:
     """Write one object (checked against the dictionary first) and return what was written.
 
     A control word that enables operation needs the caller's live motion client, as on the REST route."""

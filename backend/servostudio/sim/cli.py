@@ -16,7 +16,7 @@ DEFAULT_SOCKETCAND = "127.0.0.1:29536"
 
 
 def host_port(text: str) -> tuple[str, int]:
-    """"HOST:PORT" (port 0 = any free port) for argparse."""
+    """ "HOST:PORT" (port 0 = any free port) for argparse."""
     host, separator, port = text.rpartition(":")
     if not separator or not host or not port.isdigit() or int(port) > 65535:
         raise argparse.ArgumentTypeError(f"expected HOST:PORT, got {text!r}")
@@ -26,23 +26,48 @@ def host_port(text: str) -> tuple[str, int]:
 def register(commands: argparse._SubParsersAction) -> None:
     sim = commands.add_parser("sim", help="run simulated drives (socketcand server, RS-232 link)")
     sim.add_argument("--nodes", default="1", help='node list, e.g. "1,2,3" or "1:xtrapulspac,2:cd1k" (default: 1)')
-    sim.add_argument("--device", default="xtrapulspac", help="device of nodes listed without one (default: xtrapulspac)")
-    sim.add_argument("--socketcand", type=host_port, default=host_port(DEFAULT_SOCKETCAND), metavar="HOST:PORT",
-                     help=f"socketcand endpoint, channel can0 (default: {DEFAULT_SOCKETCAND})")
+    sim.add_argument(
+        "--device", default="xtrapulspac", help="device of nodes listed without one (default: xtrapulspac)"
+    )
+    sim.add_argument(
+        "--socketcand",
+        type=host_port,
+        default=host_port(DEFAULT_SOCKETCAND),
+        metavar="HOST:PORT",
+        help=f"socketcand endpoint, channel can0 (default: {DEFAULT_SOCKETCAND})",
+    )
     sim.add_argument("--channel", default="can0", help="socketcand channel name (default: can0)")
-    sim.add_argument("--serial-tcp", type=host_port, metavar="HOST:PORT",
-                     help="RS-232 link of the first node as a raw TCP stream (pyserial socket://HOST:PORT)")
+    sim.add_argument(
+        "--serial-tcp",
+        type=host_port,
+        metavar="HOST:PORT",
+        help="RS-232 link of the first node as a raw TCP stream (pyserial socket://HOST:PORT)",
+    )
     sim.add_argument("--serial-pty", action="store_true", help="RS-232 link of the first node as a pseudo-terminal")
-    sim.add_argument("--serial-quirk", action="store_true",
-                     help="reproduce the firmware quirk: SDO responses on the line carry the request identifier")
+    sim.add_argument(
+        "--serial-quirk",
+        action="store_true",
+        help="reproduce the firmware quirk: SDO responses on the line carry the request identifier",
+    )
     sim.add_argument("--plant", type=Path, metavar="FILE.json", help="hidden plant of every drive (JSON)")
     sim.add_argument("--seed", type=int, help="generate the plants from this seed (+ node ID) instead")
-    sim.add_argument("--bitrate", type=int, default=1_000_000, metavar="BPS",
-                     help="CAN bit rate of the timing model, 0 = frames take no time (default: 1000000)")
-    sim.add_argument("--sdo-response-time", type=float, default=1e-3, metavar="SECONDS",
-                     help="drive-side SDO response time (default: 0.001)")
-    sim.add_argument("--state-dir", type=Path, metavar="DIR",
-                     help="directory of the drives' flash files (default: in memory)")
+    sim.add_argument(
+        "--bitrate",
+        type=int,
+        default=1_000_000,
+        metavar="BPS",
+        help="CAN bit rate of the timing model, 0 = frames take no time (default: 1000000)",
+    )
+    sim.add_argument(
+        "--sdo-response-time",
+        type=float,
+        default=1e-3,
+        metavar="SECONDS",
+        help="drive-side SDO response time (default: 0.001)",
+    )
+    sim.add_argument(
+        "--state-dir", type=Path, metavar="DIR", help="directory of the drives' flash files (default: in memory)"
+    )
     sim.set_defaults(handler=run)
 
 

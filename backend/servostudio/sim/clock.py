@@ -23,7 +23,7 @@ CONTROL_PERIOD = 250e-6
 class Timer:
     """Handle of a scheduled event; `cancel()` makes it a no-op."""
 
-    __slots__ = ("when", "callback", "cancelled")
+    __slots__ = ("callback", "cancelled", "when")
 
     def __init__(self, when: float, callback: Callable[[], None]) -> None:
         self.when = when

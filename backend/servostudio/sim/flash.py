@@ -30,9 +30,9 @@ from servostudio.formats.sequence_writer import format_sequence_table
 from servostudio.formats.textfile import FILE_ENCODING, write_text_atomic
 from servostudio.od.datatypes import DataType
 from servostudio.od.model import SaveType, Value, Variable
+from servostudio.sim import sdo_abort
 from servostudio.sim.clock import VirtualClock
 from servostudio.sim.events import DriveEvents
-from servostudio.sim import sdo_abort
 from servostudio.sim.objects import ObjectStore, check_range
 from servostudio.sim.sdo_abort import SdoAbort
 from servostudio.sim.sequences import SequenceMemory
@@ -50,7 +50,7 @@ OPERATION_TIME = 0.2
 
 
 def signature(text: str) -> int:
-    """"save" -> 0x65766173: the four ASCII characters as a little-endian U32."""
+    """ "save" -> 0x65766173: the four ASCII characters as a little-endian U32."""
     return int.from_bytes(text.encode("ascii"), "little")
 
 

@@ -26,5 +26,5 @@ class Frame:
         return len(self.data)
 
     @classmethod
-    def remote(cls, can_id: int, dlc: int = 0) -> "Frame":
+    def remote(cls, can_id: int, dlc: int = 0) -> Frame:
         return cls(can_id, bytes(dlc), rtr=True)

@@ -47,7 +47,7 @@ def from_message(message: can.Message) -> Frame:
 
 
 class SimulatedCanBus(can.BusABC):
-    def __init__(self, network: "SimulatedNetwork", channel: str = "sim", **kwargs: Any) -> None:
+    def __init__(self, network: SimulatedNetwork, channel: str = "sim", **kwargs: Any) -> None:
         self._network = network
         self._received: queue.SimpleQueue[can.Message] = queue.SimpleQueue()
         self.overruns = 0
@@ -78,8 +78,11 @@ class SimulatedCanBus(can.BusABC):
                 messages.append(self._received.get_nowait())
         except queue.Empty:
             pass
-        return [(message.arbitration_id, bytes(message.data), message.timestamp, message.is_extended_id)
-                for message in messages if not message.is_remote_frame]
+        return [
+            (message.arbitration_id, bytes(message.data), message.timestamp, message.is_extended_id)
+            for message in messages
+            if not message.is_remote_frame
+        ]
 
     def send(self, msg: can.Message, timeout: float | None = None) -> None:
         self._network.inject(from_message(msg), sender=self)

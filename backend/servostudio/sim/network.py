@@ -60,7 +60,7 @@ class NodeSpec:
 
 
 def parse_node_list(text: str, default_device: str = DEFAULT_DEVICE) -> list[NodeSpec]:
-    """"1,2,3" or "1:xtrapulspac,2:xtrapulspac,3:cd1k" -> node specs (IDs 1..127, each once)."""
+    """ "1,2,3" or "1:xtrapulspac,2:xtrapulspac,3:cd1k" -> node specs (IDs 1..127, each once)."""
     specs: list[NodeSpec] = []
     for item in text.split(","):
         item = item.strip()
@@ -115,9 +115,11 @@ class SimulatedNetwork:
         sdo_response_time: float = DEFAULT_RESPONSE_TIME,
         state_dir: Path | None = None,
     ) -> None:
-        specs = parse_node_list(nodes, device) if isinstance(nodes, str) else [
-            spec if isinstance(spec, NodeSpec) else NodeSpec(int(spec), device) for spec in nodes
-        ]
+        specs = (
+            parse_node_list(nodes, device)
+            if isinstance(nodes, str)
+            else [spec if isinstance(spec, NodeSpec) else NodeSpec(int(spec), device) for spec in nodes]
+        )
         if not specs:
             raise ValueError("a simulated network needs at least one node")
         self.lock = threading.RLock()
@@ -251,7 +253,7 @@ class SimulatedNetwork:
             except Exception:
                 log.exception("action posted from outside failed at t=%.6f s", self.clock.now)
 
-    def __enter__(self) -> "SimulatedNetwork":
+    def __enter__(self) -> SimulatedNetwork:
         return self
 
     def __exit__(self, *exc: object) -> None:

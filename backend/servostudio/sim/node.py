@@ -86,14 +86,26 @@ class SimulatedNode:
         self.events = DriveEvents(self.store, self.transmit, lambda: self.state.value, self._emcy_allowed)
         self.sequences = SequenceMemory.for_store(self.store)
         self.events.sequences = self.sequences
-        self.flash = FlashFiles(self.store, clock, self.events, self._drive_error,
-                                None if state_dir is None else state_dir / f"node{node_id}", self.sequences)
+        self.flash = FlashFiles(
+            self.store,
+            clock,
+            self.events,
+            self._drive_error,
+            None if state_dir is None else state_dir / f"node{node_id}",
+            self.sequences,
+        )
         self.pdo = PdoEngine(self.store, clock, self.transmit, lambda code: self.events.emergency(code))
         self.error_control = ErrorControl(self.store, clock, self.transmit, lambda: self.state, self._network_error)
-        self.sdo = SdoServer(self.store, clock, SDO_RESPONSE_BASE + node_id, sdo_response_time,
-                             self.flash.confirmation_delay)
-        self.redirected_sdo = SdoServer(self.store, clock, REDIRECTED_RESPONSE_BASE + node_id, sdo_response_time,
-                                        self.flash.confirmation_delay) if node_id < 64 else None
+        self.sdo = SdoServer(
+            self.store, clock, SDO_RESPONSE_BASE + node_id, sdo_response_time, self.flash.confirmation_delay
+        )
+        self.redirected_sdo = (
+            SdoServer(
+                self.store, clock, REDIRECTED_RESPONSE_BASE + node_id, sdo_response_time, self.flash.confirmation_delay
+            )
+            if node_id < 64
+            else None
+        )
         self._sdo_request_ids = frozenset(self.sdo_request_ids())
         self._register_hooks()
         self._errors_before_boot: list[int] = []

@@ -133,8 +133,9 @@ class PdoEngine:
         self.rpdos = self._read_pdos(RPDO_COMMUNICATION, RPDO_MAPPING, receive=True)
         self.tpdos = self._read_pdos(TPDO_COMMUNICATION, TPDO_MAPPING, receive=False)
         counting = (TPDO_COUNT, 0) in self.store  # type 254 is TPDO_Count mode, not event-driven
-        self._event_tpdos = [pdo for pdo in self.tpdos
-                             if pdo.transmission_type == 255 or (pdo.transmission_type == 254 and not counting)]
+        self._event_tpdos = [
+            pdo for pdo in self.tpdos if pdo.transmission_type == 255 or (pdo.transmission_type == 254 and not counting)
+        ]
         self._dirty = False
 
     def _read_pdos(self, communication: int, mapping: int, receive: bool) -> list[Pdo]:
@@ -241,7 +242,9 @@ class PdoEngine:
                 if payload != pdo.last_payload:
                     self._send(pdo, payload)
             elif kind == 254 and counter is not None:
-                if (TPDO_CONTROL, pdo.number + 1) in self.store and counter == self.store.get(TPDO_CONTROL, pdo.number + 1):
+                if (TPDO_CONTROL, pdo.number + 1) in self.store and counter == self.store.get(
+                    TPDO_CONTROL, pdo.number + 1
+                ):
                     self._send(pdo)
 
     def poll(self) -> None:

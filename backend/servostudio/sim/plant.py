@@ -233,15 +233,32 @@ def _is_number(value: Any) -> bool:
 def _validate(plant: Plant) -> list[str]:
     problems: list[str] = []
     positive = (
-        "torque_constant", "phase_resistance", "inductance", "motor_inertia", "peak_current", "stall_current",
-        "dc_bus_voltage", "dc_bus_capacitance", "supply_resistance", "braking_resistance", "braking_on_voltage",
-        "overvoltage", "thermal_resistance", "thermal_time_constant",
+        "torque_constant",
+        "phase_resistance",
+        "inductance",
+        "motor_inertia",
+        "peak_current",
+        "stall_current",
+        "dc_bus_voltage",
+        "dc_bus_capacitance",
+        "supply_resistance",
+        "braking_resistance",
+        "braking_on_voltage",
+        "overvoltage",
+        "thermal_resistance",
+        "thermal_time_constant",
     )
     for name in positive:
         if not getattr(plant, name) > 0:
             problems.append(f"{name!r} must be > 0")
-    for name in ("load_inertia", "viscous_friction", "coulomb_friction", "coupling_stiffness", "coupling_damping",
-                 "brake_torque"):
+    for name in (
+        "load_inertia",
+        "viscous_friction",
+        "coulomb_friction",
+        "coupling_stiffness",
+        "coupling_damping",
+        "brake_torque",
+    ):
         if getattr(plant, name) < 0:
             problems.append(f"{name!r} must be >= 0")
     if not 1 <= plant.pole_pairs <= 24:
@@ -283,7 +300,10 @@ def _check_order(plant: Plant) -> list[str]:
             problems.append(f"{name!r} ({value}) must be above 'negative_hard_stop' ({low})")
         if high is not None and not value < high:
             problems.append(f"{name!r} ({value}) must be below 'positive_hard_stop' ({high})")
-    if (plant.negative_limit_switch is not None and plant.positive_limit_switch is not None
-            and not plant.negative_limit_switch < plant.positive_limit_switch):
+    if (
+        plant.negative_limit_switch is not None
+        and plant.positive_limit_switch is not None
+        and not plant.negative_limit_switch < plant.positive_limit_switch
+    ):
         problems.append("'negative_limit_switch' must be below 'positive_limit_switch'")
     return problems

@@ -29,7 +29,7 @@ class SequenceMemory:
         store.on_read(SEQUENCE_PARAMETERS_INDEX, None, self._read)
 
     @classmethod
-    def for_store(cls, store: ObjectStore) -> "SequenceMemory | None":
+    def for_store(cls, store: ObjectStore) -> SequenceMemory | None:
         """A memory when the device has the sequence objects, else None."""
         if (SEQUENCE_NUMBER_INDEX, 0) in store and (SEQUENCE_PARAMETERS_INDEX, 1) in store:
             return cls(store)

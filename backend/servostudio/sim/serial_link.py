@@ -28,7 +28,6 @@ from servostudio.sim.node import REDIRECTED_REQUEST_BASE, REDIRECTED_RESPONSE_BA
 from servostudio.sim.tcp import TcpListener
 from servostudio.transport.rs232_framing import DRIVE_HEADER, HOST_HEADER, FrameDecoder, encode_frame
 
-
 FORWARDED = range(REDIRECTED_REQUEST_BASE + 1, REDIRECTED_REQUEST_BASE + 64)  # 0x641–0x67F
 RELAYED = range(REDIRECTED_RESPONSE_BASE + 1, REDIRECTED_RESPONSE_BASE + 64)  # 0x5C1–0x5FF
 SDO_RESPONSES = range(0x581, 0x600)
@@ -62,8 +61,9 @@ class _Writer:
 class SerialGateway:
     """Drive side of the serial line; a station on the CAN bus for the relayed responses."""
 
-    def __init__(self, network: SimulatedNetwork, node: SimulatedNode | None = None,
-                 response_id_quirk: bool = False) -> None:
+    def __init__(
+        self, network: SimulatedNetwork, node: SimulatedNode | None = None, response_id_quirk: bool = False
+    ) -> None:
         self.network = network
         self.node = node or network.first_node
         self.response_id_quirk = response_id_quirk
@@ -159,7 +159,7 @@ class SerialPty:
         self._writer = _Writer(lambda data: os.write(self._master, data), "serial-pty-tx")
         self._thread = threading.Thread(target=self._read_loop, name="serial-pty-rx", daemon=True)
 
-    def start(self) -> "SerialPty":
+    def start(self) -> SerialPty:
         self.gateway.add_writer(self._writer)
         self._thread.start()
         return self
@@ -173,7 +173,7 @@ class SerialPty:
         os.close(self._master)
         os.close(self._slave)
 
-    def __enter__(self) -> "SerialPty":
+    def __enter__(self) -> SerialPty:
         return self.start()
 
     def __exit__(self, *exc: object) -> None:

@@ -21,7 +21,6 @@ from servostudio.sim.frame import Frame
 from servostudio.sim.network import SimulatedNetwork
 from servostudio.sim.tcp import TcpListener
 
-
 DEFAULT_PORT = 29536
 DEFAULT_CHANNEL = "can0"
 SETTLE_TIME = 0.1
@@ -51,8 +50,13 @@ class SocketcandServer(TcpListener):
 
     name = "socketcand"
 
-    def __init__(self, network: SimulatedNetwork, host: str = "127.0.0.1", port: int = DEFAULT_PORT,
-                 channel: str = DEFAULT_CHANNEL) -> None:
+    def __init__(
+        self,
+        network: SimulatedNetwork,
+        host: str = "127.0.0.1",
+        port: int = DEFAULT_PORT,
+        channel: str = DEFAULT_CHANNEL,
+    ) -> None:
         super().__init__(host, port)
         self.network = network
         self.channel = channel
@@ -67,7 +71,7 @@ class SocketcandServer(TcpListener):
         for session in list(self._sessions):
             session.close()
 
-    def _forget(self, session: "_Session") -> None:
+    def _forget(self, session: _Session) -> None:
         if session in self._sessions:
             self._sessions.remove(session)
 
@@ -119,7 +123,7 @@ class _Session:
         with self._queued_lock:
             if self._queued == 0:
                 try:
-                    data = data[self.connection.send(data, socket.MSG_DONTWAIT):]
+                    data = data[self.connection.send(data, socket.MSG_DONTWAIT) :]
                 except BlockingIOError:
                     pass
                 except OSError:
@@ -160,7 +164,7 @@ class _Session:
         """`sendall` for the non-blocking socket: wait until it can take more (OSError once it is closed)."""
         while data:
             try:
-                data = data[self.connection.send(data):]
+                data = data[self.connection.send(data) :]
             except BlockingIOError:
                 select.select([], [self.connection], [], WRITE_POLL)
                 if self._closed.is_set():

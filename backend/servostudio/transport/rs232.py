@@ -54,8 +54,9 @@ class RS232Bus(can.BusABC):
 
     def __init__(self, channel: str, baudrate: int = 19200, cable_node: int | None = None, **kwargs: object) -> None:
         try:
-            self._port = serial.serial_for_url(channel, baudrate=baudrate, bytesize=8, parity="N", stopbits=1,
-                                               timeout=0.05, write_timeout=1.0)
+            self._port = serial.serial_for_url(
+                channel, baudrate=baudrate, bytesize=8, parity="N", stopbits=1, timeout=0.05, write_timeout=1.0
+            )
         except (serial.SerialException, ValueError) as error:
             raise can.CanInitializationError(f"cannot open serial link {channel}: {error}") from error
         self.channel_info = f"XtrapulsPac RS-232 link {channel} @ {baudrate} baud"
@@ -95,9 +96,16 @@ class RS232Bus(can.BusABC):
         except (serial.SerialException, OSError) as error:
             raise can.CanOperationError(f"serial link lost: {error}") from error
         for cob_id, data in self._decoder.feed(chunk):
-            self._received.append(can.Message(arbitration_id=link_to_host(cob_id), data=data, dlc=len(data),
-                                              is_extended_id=False, timestamp=time.time(),
-                                              channel=self.channel_info))
+            self._received.append(
+                can.Message(
+                    arbitration_id=link_to_host(cob_id),
+                    data=data,
+                    dlc=len(data),
+                    is_extended_id=False,
+                    timestamp=time.time(),
+                    channel=self.channel_info,
+                )
+            )
 
     def shutdown(self) -> None:
         super().shutdown()

@@ -93,8 +93,9 @@ class SocketcandBus(can.BusABC):
         if not self._frames:
             return None, False
         identifier, data, timestamp, extended = self._frames.popleft()
-        return can.Message(arbitration_id=identifier, data=data, dlc=len(data), timestamp=timestamp,
-                           is_extended_id=extended), False
+        return can.Message(
+            arbitration_id=identifier, data=data, dlc=len(data), timestamp=timestamp, is_extended_id=extended
+        ), False
 
     def shutdown(self) -> None:
         super().shutdown()
@@ -147,5 +148,7 @@ def _send_command(cob_id: int, data: bytes, extended: bool = False) -> str:
 
 def _parse_frames(text: bytes) -> list[Frame]:
     """Every ``< frame ID SECONDS.MICROS HEXDATA >`` in ``text``; other server messages (errors, echoes) are skipped."""
-    return [(int(identifier, 16), bytes.fromhex(data.decode()), float(stamp), len(identifier) > 3)
-            for identifier, stamp, data in _FRAME.findall(text)]
+    return [
+        (int(identifier, 16), bytes.fromhex(data.decode()), float(stamp), len(identifier) > 3)
+        for identifier, stamp, data in _FRAME.findall(text)
+    ]

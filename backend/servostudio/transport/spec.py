@@ -52,8 +52,11 @@ class BusSpec:
         if self.kind == "socketcand":
             return {"interface": "socketcand", "host": self.host, "port": self.port, "channel": self.channel}
         if self.kind == "serial":
-            return {"interface": "servostudio_rs232", "channel": self.channel,
-                    "baudrate": self.bitrate or DEFAULT_SERIAL_BAUDRATE}
+            return {
+                "interface": "servostudio_rs232",
+                "channel": self.channel,
+                "baudrate": self.bitrate or DEFAULT_SERIAL_BAUDRATE,
+            }
         config: dict[str, object] = {"interface": self.kind, "channel": self.channel}
         if self.kind in _INTEGER_CHANNEL:
             config["channel"] = int(self.channel)

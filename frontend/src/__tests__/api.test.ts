@@ -1,5 +1,5 @@
 import { describe, expect, it } from "vitest";
-import { ApiError, getHealth, projectAddress, request } from "../api";
+import { ApiError, getHealth, projectAddress, request } from "../client/api";
 
 const answer = (body: unknown, status: number) =>
   (async () => new Response(JSON.stringify(body), { status, headers: { "Content-Type": "application/json" } })) as unknown as typeof fetch;

@@ -1,5 +1,5 @@
 import { describe, expect, it } from "vitest";
-import { busNames, learnBuses, serverBus, type BusInfo } from "../drives";
+import { busNames, learnBuses, serverBus, type BusInfo } from "../client/drives";
 
 const bus = (id: string, spec: string): BusInfo => ({ id, spec, kind: spec.split(":")[0], connected: true, error: null, nodes: [] });
 

@@ -1,6 +1,6 @@
 import { afterEach, describe, expect, it, vi } from "vitest";
-import { runJob, type JobInfo } from "../jobs";
-import { LiveHub } from "../live";
+import { runJob, type JobInfo } from "../client/jobs";
+import { LiveHub } from "../client/live";
 
 const running = (id: string): JobInfo => ({ id, operation: "restore", state: "running", result: null, error: null });
 

@@ -1,5 +1,5 @@
 import { describe, expect, it } from "vitest";
-import { LiveHub, axisStateText } from "../live";
+import { LiveHub, axisStateText } from "../client/live";
 
 describe("live axis state", () => {
   it("follows NMT, EMCY and heartbeat events of the axis's bus and node", () => {

@@ -80,7 +80,7 @@ describe("search", () => {
   });
 });
 
-import { dashboardSignals } from "../lib/signals";
+import { dashboardSignals } from "../lib/dashboard-objects";
 
 describe("dashboard signals", () => {
   it("takes the CiA 402 measurements the dictionary has and finds temperatures by unit", () => {

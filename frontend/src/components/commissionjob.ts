@@ -6,10 +6,10 @@
  */
 
 import type { App } from "../app";
-import { post } from "../api";
-import { cancelJob } from "../jobs";
+import { post } from "../client/api";
+import { cancelJob } from "../client/jobs";
 import { h, replaceChildren } from "../lib/dom";
-import type { LiveEvent } from "../live";
+import type { LiveEvent } from "../client/live";
 import { confirmAction, errorText } from "./ui";
 
 interface JobInfo {

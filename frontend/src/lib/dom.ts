@@ -1,54 +1,229 @@
-/** Minimal DOM construction: the UI is plain TypeScript, no framework, so the bundle stays small. */
+/**
+ * DOM construction with reactive bindings, on the pattern of VanJS: a page holds its state in small `State`
+ * values and binds them to attributes and children when it builds its elements; changing `state.val` updates
+ * exactly the bound places. No virtual DOM, no re-render calls, no framework: the whole binding is this file.
+ *
+ * - `state(v)` — a value that tells its readers when it changes.
+ * - `derive(fn)` — a state computed from others; re-computed when one of the states `fn` read changes.
+ * - `effect(fn)` — run `fn` now and whenever a state it read changes; returns a function that stops it.
+ * - `h(tag, attrs, ...children)` — an element; an attribute value or a child may be a `State` or a function
+ *   (`() => value`), which binds it: the attribute or the child node follows the states the function read.
+ *
+ * Bindings hold their DOM node weakly: once a page's element is dropped and collected, its bindings stop.
+ * An `effect` (and a `derive` on a state that outlives the page, such as the live hub's) must be stopped by the
+ * page's `dispose`; `Scope` collects those stops.
+ */
 
-type Child = Node | string | number | null | undefined | false | Child[];
+export type Child = Node | string | number | null | undefined | false | Child[];
+export type Bindable<T> = T | State<T> | (() => T);
 type Attrs = Record<string, unknown>;
 
+type Listener = () => void;
+
+/** The reader currently being tracked: every state read while it runs becomes one of its dependencies. */
+let tracking: Set<StateImpl<unknown>> | null = null;
+
+export interface State<T> {
+  val: T;
+  /** The value without registering the reader as a dependency. */
+  readonly rawVal: T;
+}
+
+class StateImpl<T> implements State<T> {
+  private current: T;
+  readonly listeners = new Set<Listener>();
+
+  constructor(initial: T) {
+    this.current = initial;
+  }
+
+  get val(): T {
+    tracking?.add(this as StateImpl<unknown>);
+    return this.current;
+  }
+
+  set val(next: T) {
+    if (Object.is(next, this.current)) return;
+    this.current = next;
+    for (const listener of [...this.listeners]) listener();
+  }
+
+  get rawVal(): T {
+    return this.current;
+  }
+}
+
+export function state<T>(initial: T): State<T> {
+  return new StateImpl(initial);
+}
+
+export function isState(value: unknown): value is State<unknown> {
+  return value instanceof StateImpl;
+}
+
 /**
- * Create an element. Attributes starting with "on" become listeners, `class`/`text`/`dataset`/`style`
- * are handled specially, `true` sets a boolean attribute and `false`/`null`/`undefined` omits it.
+ * Run `compute` tracking the states it reads, and call `changed` (once per change) when one of them changes;
+ * dependencies are re-collected on every run, so a branch not taken costs nothing. Returns the stop function.
+ */
+function track<T>(compute: () => T, changed: (value: T) => void): { first: T; stop: () => void } {
+  let sources = new Set<StateImpl<unknown>>();
+  let stopped = false;
+  const run = (): T => {
+    const previous = tracking;
+    const reads = new Set<StateImpl<unknown>>();
+    tracking = reads;
+    try {
+      return compute();
+    } finally {
+      tracking = previous;
+      for (const source of sources) if (!reads.has(source)) source.listeners.delete(listener);
+      for (const source of reads) source.listeners.add(listener);
+      sources = reads;
+    }
+  };
+  const listener = () => {
+    if (!stopped) changed(run());
+  };
+  const stop = () => {
+    stopped = true;
+    for (const source of sources) source.listeners.delete(listener);
+    sources.clear();
+  };
+  return { first: run(), stop };
+}
+
+/** A state computed from other states. */
+export function derive<T>(compute: () => T): State<T> {
+  let derived: StateImpl<T> | null = null;
+  const { first } = track(compute, (value) => {
+    if (derived) derived.val = value;
+  });
+  derived = new StateImpl(first);
+  return derived;
+}
+
+/** Run `fn` now and again whenever a state it read changes, until the returned function is called. */
+export function effect(fn: () => void): () => void {
+  return track(fn, () => undefined).stop;
+}
+
+/** Stops of effects and subscriptions that end with a page (`dispose`). */
+export class Scope {
+  private readonly stops: (() => void)[] = [];
+
+  effect(fn: () => void): void {
+    this.stops.push(effect(fn));
+  }
+
+  /** Register any other clean-up (an interval, a socket, a hub subscription). */
+  add(stop: () => void): void {
+    this.stops.push(stop);
+  }
+
+  dispose(): void {
+    for (const stop of this.stops.splice(0)) stop();
+  }
+}
+
+/** The current value of a bindable, tracked when read inside a binding. */
+export function valueOf<T>(value: Bindable<T>): T {
+  if (isState(value)) return (value as State<T>).val;
+  if (typeof value === "function") return (value as () => T)();
+  return value;
+}
+
+/**
+ * Bind `read` to `node`: `apply` runs now and on every change while `node` is alive (held weakly, so a
+ * dropped page's bindings end with its elements).
+ */
+function bind<T>(node: Node, read: () => T, apply: (target: Node, value: T) => void): void {
+  const ref = new WeakRef(node);
+  const { first, stop } = track(read, (value) => {
+    const target = ref.deref();
+    if (target) apply(target, value);
+    else stop();
+  });
+  apply(node, first);
+}
+
+function isBound(value: unknown): value is State<unknown> | (() => unknown) {
+  return isState(value) || typeof value === "function";
+}
+
+function setAttribute(element: HTMLElement, key: string, value: unknown): void {
+  if (key === "class") element.className = value === false || value == null ? "" : String(value);
+  else if (key === "text") element.textContent = value == null ? "" : String(value);
+  else if (key === "value" && "value" in element) (element as HTMLInputElement).value = value == null ? "" : String(value);
+  else if ((key === "checked" || key === "disabled" || key === "hidden") && key in element)
+    (element as unknown as Record<string, boolean>)[key] = Boolean(value);
+  else if (value === false || value === null || value === undefined) element.removeAttribute(key);
+  else element.setAttribute(key, value === true ? "" : String(value));
+}
+
+function applyAttribute(element: HTMLElement, key: string, value: unknown): void {
+  if (key.startsWith("on") && typeof value === "function") {
+    element.addEventListener(key.slice(2).toLowerCase(), value as EventListener);
+  } else if (key === "dataset") {
+    Object.assign(element.dataset, value as Record<string, string>);
+  } else if (key === "style" && typeof value === "object" && value !== null) {
+    Object.assign(element.style, value);
+  } else if (isBound(value)) {
+    bind(element, () => valueOf(value), (target, current) => setAttribute(target as HTMLElement, key, current));
+  } else if (value !== false && value !== null && value !== undefined) {
+    setAttribute(element, key, value);
+  }
+}
+
+/**
+ * Create an element. Attributes starting with "on" become listeners; `class`, `text`, `value`, `checked`,
+ * `disabled`, `hidden` set the property; `dataset`/`style` objects are merged; `true` sets a boolean attribute,
+ * `false`/`null`/`undefined` omits it. Any other value that is a `State` or a function is bound.
  */
 export function h<K extends keyof HTMLElementTagNameMap>(
   tag: K,
   attrs: Attrs | null = null,
-  ...children: Child[]
+  ...children: (Child | Bindable<Child>)[]
 ): HTMLElementTagNameMap[K] {
   const element = document.createElement(tag);
-  if (attrs) {
-    for (const [key, value] of Object.entries(attrs)) {
-      if (value === false || value === null || value === undefined) continue;
-      if (key.startsWith("on") && typeof value === "function") {
-        element.addEventListener(key.slice(2).toLowerCase(), value as EventListener);
-      } else if (key === "class") {
-        element.className = String(value);
-      } else if (key === "text") {
-        element.textContent = String(value);
-      } else if (key === "dataset") {
-        Object.assign(element.dataset, value as Record<string, string>);
-      } else if (key === "style" && typeof value === "object") {
-        Object.assign(element.style, value);
-      } else if (key === "value" && "value" in element) {
-        (element as HTMLInputElement).value = String(value);
-      } else if (value === true) {
-        element.setAttribute(key, "");
-      } else {
-        element.setAttribute(key, String(value));
-      }
-    }
-  }
+  if (attrs) for (const [key, value] of Object.entries(attrs)) applyAttribute(element, key, value);
   append(element, children);
   return element;
 }
 
-function append(parent: Node, children: Child[]): void {
+function toNodes(child: Child): Node[] {
+  if (child === null || child === undefined || child === false) return [];
+  if (Array.isArray(child)) return child.flatMap(toNodes);
+  return [typeof child === "object" ? child : document.createTextNode(String(child))];
+}
+
+/**
+ * A bound child: the nodes between two empty text markers are replaced whenever the states read by `read`
+ * change (a list, an optional part, a text).
+ */
+function boundChild(read: () => Child): DocumentFragment {
+  const start = document.createTextNode("");
+  const end = document.createTextNode("");
+  const fragment = document.createDocumentFragment();
+  fragment.append(start, end);
+  bind(start, read, (marker, child) => {
+    const parent = marker.parentNode;
+    if (!parent) return;
+    while (marker.nextSibling && marker.nextSibling !== end) parent.removeChild(marker.nextSibling);
+    for (const node of toNodes(child)) parent.insertBefore(node, end);
+  });
+  return fragment;
+}
+
+function append(parent: Node, children: (Child | Bindable<Child>)[]): void {
   for (const child of children) {
-    if (child === null || child === undefined || child === false) continue;
-    if (Array.isArray(child)) append(parent, child);
-    else parent.appendChild(typeof child === "object" ? child : document.createTextNode(String(child)));
+    if (isBound(child)) parent.appendChild(boundChild(() => valueOf(child) as Child));
+    else if (Array.isArray(child)) append(parent, child);
+    else for (const node of toNodes(child as Child)) parent.appendChild(node);
   }
 }
 
 /** Replace all children of `parent`. */
-export function replaceChildren(parent: Element, ...children: Child[]): void {
+export function replaceChildren(parent: Element, ...children: (Child | Bindable<Child>)[]): void {
   parent.textContent = "";
   append(parent, children);
 }

@@ -1,11 +1,11 @@
 /** The pages of one axis: header with device, node and live state, tabs, and the chosen view. */
 
 import type { Page, PageContext } from "../app";
-import { getDictionary, projects, type AxisConfig, type Project } from "../api";
+import { getDictionary, projects, type AxisConfig, type Project } from "../client/api";
 import { h } from "../lib/dom";
 import type { Dictionary } from "../lib/od";
 import { buildPath, type AxisView } from "../lib/router";
-import { axisStateText } from "../live";
+import { axisStateText } from "../client/live";
 import { backupView } from "./backup";
 import { commissioningView } from "./commissioning";
 import { dashboardView } from "./dashboard";

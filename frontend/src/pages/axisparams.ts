@@ -1,8 +1,8 @@
 /** Parameters of one axis: the dictionary editor wired to the drive (when online) and to the project files. */
 
-import { projectAddress, projects, setParametersSkipping } from "../api";
+import { projectAddress, projects, setParametersSkipping } from "../client/api";
 import { toast } from "../components/ui";
-import { driveApi } from "../drives";
+import { driveApi } from "../client/drives";
 import { entryKey } from "../lib/od";
 import type { AxisContext, AxisViewPage } from "./axis";
 import { ParameterEditor, type DriveCell } from "./parameters";

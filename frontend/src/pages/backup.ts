@@ -4,10 +4,10 @@
  * cancelled between objects.
  */
 
-import { projectAddress, projects, request, setParametersSkipping } from "../api";
+import { projectAddress, projects, request, setParametersSkipping } from "../client/api";
 import { confirmAction, errorText, pickFile } from "../components/ui";
-import { driveApi } from "../drives";
-import { runJob, type JobInfo } from "../jobs";
+import { driveApi } from "../client/drives";
+import { runJob, type JobInfo } from "../client/jobs";
 import { h, replaceChildren } from "../lib/dom";
 import { entries, isReadable, isWritable, type Entry } from "../lib/od";
 import { unstorableReason } from "../lib/values";

@@ -1,9 +1,9 @@
 /** Buses: connect by spec string, scan, add found drives to a project, NMT broadcast, close. */
 
 import type { Page, PageContext } from "../app";
-import { projects, type Project } from "../api";
+import { projects, type Project } from "../client/api";
 import { confirmAction, errorText, openDialog, toast } from "../components/ui";
-import { driveApi, type BusInfo, type NodeIdentity } from "../drives";
+import { driveApi, type BusInfo, type NodeIdentity } from "../client/drives";
 import { h, replaceChildren } from "../lib/dom";
 import { formatHex } from "../lib/numbers";
 import { buildPath } from "../lib/router";

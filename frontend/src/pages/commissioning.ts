@@ -1,6 +1,6 @@
 /** Commissioning checklist of one axis in the manual's order; each step links to the page or group that does it. */
 
-import { projects, type Template } from "../api";
+import { projects, type Template } from "../client/api";
 import { errorText, openDialog, toast } from "../components/ui";
 import { STEPS, stepKeys, stepStatus, type Step } from "../lib/commissioning";
 import { h, replaceChildren } from "../lib/dom";

@@ -4,8 +4,8 @@
  */
 
 import type { Page, PageContext } from "../app";
-import { getDictionary, projects, type Project } from "../api";
-import { driveApi } from "../drives";
+import { getDictionary, projects, type Project } from "../client/api";
+import { driveApi } from "../client/drives";
 import { errorText } from "../components/ui";
 import { h, replaceChildren } from "../lib/dom";
 import { entries, entryKey, type Entry, type Scalar } from "../lib/od";

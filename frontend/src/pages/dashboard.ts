@@ -5,9 +5,9 @@
  * bit changes.
  */
 
-import { projectAddress } from "../api";
+import { projectAddress } from "../client/api";
 import { errorText, toast } from "../components/ui";
-import { driveApi, serverBus, type FaultReport, type ObjectValue } from "../drives";
+import { driveApi, serverBus, type FaultReport, type ObjectValue } from "../client/drives";
 import { fieldLabel, extractBits } from "../lib/bits";
 import {
   COMMAND_LABELS,
@@ -19,9 +19,9 @@ import {
 } from "../lib/cia402";
 import { h, replaceChildren } from "../lib/dom";
 import { enumOptions, type Entry } from "../lib/od";
-import { PROFILE_VELOCITY_MODE, dashboardSignals } from "../lib/signals";
+import { PROFILE_VELOCITY_MODE, dashboardSignals } from "../lib/dashboard-objects";
 import { editText, formatValue, parseValue } from "../lib/values";
-import { TerminalSocket, type WatchRow } from "../terminal";
+import { TerminalSocket, type WatchRow } from "../client/terminal-socket";
 import type { AxisContext, AxisViewPage } from "./axis";
 
 const LIVE_PERIOD_MS = 200;

@@ -1,7 +1,7 @@
 /** Object dictionaries: the library (built-in and imported EDS files) and a browser for one dictionary. */
 
 import type { Page, PageContext } from "../app";
-import { getDictionary, importDictionary, listDictionaries } from "../api";
+import { getDictionary, importDictionary, listDictionaries } from "../client/api";
 import { errorText, openDialog, toast } from "../components/ui";
 import { h, replaceChildren } from "../lib/dom";
 import { formatHex } from "../lib/numbers";

@@ -1,7 +1,7 @@
 /** Projects: list, create, open, import an archive. */
 
 import type { Page, PageContext } from "../app";
-import { ApiError, listDictionaries, projects, type Project } from "../api";
+import { ApiError, listDictionaries, projects, type Project } from "../client/api";
 import { errorText, openDialog, pickFile, toast } from "../components/ui";
 import { h, replaceChildren } from "../lib/dom";
 import { buildPath } from "../lib/router";

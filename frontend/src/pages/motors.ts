@@ -1,7 +1,7 @@
 /** Motor catalog: built-in and user motors; choose one for an axis (the drive's motor data then follow it). */
 
 import type { Page, PageContext } from "../app";
-import { projects, type Motor } from "../api";
+import { projects, type Motor } from "../client/api";
 import { errorText, openDialog, toast } from "../components/ui";
 import { h, replaceChildren } from "../lib/dom";
 

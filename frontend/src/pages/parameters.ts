@@ -3,7 +3,7 @@
  * project value and the default side by side. Used for an axis (drive + project) and for a bare dictionary.
  */
 
-import type { ProjectParameter } from "../api";
+import type { ProjectParameter } from "../client/api";
 import { confirmAction, errorText, toast } from "../components/ui";
 import { VirtualList } from "../components/vlist";
 import { decodeBits, fieldLabel, insertBits } from "../lib/bits";

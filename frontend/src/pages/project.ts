@@ -1,12 +1,12 @@
 /** One project: its buses and axes (add, edit, remove), archive download, DCF export, compare. */
 
 import type { Page, PageContext } from "../app";
-import { listDictionaries, projects, type AxisConfig, type BusConfig, type Project } from "../api";
-import { driveApi, serverBus, type BusInfo } from "../drives";
+import { listDictionaries, projects, type AxisConfig, type BusConfig, type Project } from "../client/api";
+import { driveApi, serverBus, type BusInfo } from "../client/drives";
 import { confirmAction, download, errorText, openDialog, toast } from "../components/ui";
 import { h, replaceChildren } from "../lib/dom";
 import { buildPath } from "../lib/router";
-import { axisStateText } from "../live";
+import { axisStateText } from "../client/live";
 import { commissionPanel } from "../components/commissionjob";
 
 export async function projectPage(context: PageContext, name: string): Promise<Page> {

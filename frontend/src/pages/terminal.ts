@@ -2,9 +2,9 @@
 
 import type { Page, PageContext } from "../app";
 import { errorText } from "../components/ui";
-import { driveApi, serverBus, type ObjectValue } from "../drives";
+import { driveApi, serverBus, type ObjectValue } from "../client/drives";
 import { h, replaceChildren } from "../lib/dom";
-import { TerminalSocket, type WatchRow } from "../terminal";
+import { TerminalSocket, type WatchRow } from "../client/terminal-socket";
 
 const MAX_AXES = 4;
 const MAX_ROWS = 32;

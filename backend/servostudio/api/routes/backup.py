@@ -40,26 +40,46 @@ def _nodes(connection: BusConnection, nodes: list[int] | None) -> list[int]:
     return chosen
 
 
-@router.post("/buses/{bus}/backup", response_model=JobModel, status_code=status.HTTP_202_ACCEPTED,
-             summary="Back up drives in parallel into DIRECTORY/node<N>/ (progress on /api/ws/events)")
-def start_backup(bus: str, request: BackupRequest, manager: ConnectionManager = Depends(get_connections),
-                 jobs: JobRegistry = Depends(get_jobs)) -> dict:
+@router.post(
+    "/buses/{bus}/backup",
+    response_model=JobModel,
+    status_code=status.HTTP_202_ACCEPTED,
+    summary="Back up drives in parallel into DIRECTORY/node<N>/ (progress on /api/ws/events)",
+)
+def start_backup(
+    bus: str,
+    request: BackupRequest,
+    manager: ConnectionManager = Depends(get_connections),
+    jobs: JobRegistry = Depends(get_jobs),
+) -> dict:
     connection = manager.get(bus)
     nodes, kinds, directory = _nodes(connection, request.nodes), _kinds(request.files), Path(request.directory)
 
     def work(progress, cancel) -> dict:
         drives = [connection.drive(node) for node in nodes]
-        results = run_per_drive(drives, lambda drive: backup_drive(
-            drive, directory / f"node{drive.node}", kinds, lambda event: progress({**event, "bus": bus}), cancel))
+        results = run_per_drive(
+            drives,
+            lambda drive: backup_drive(
+                drive, directory / f"node{drive.node}", kinds, lambda event: progress({**event, "bus": bus}), cancel
+            ),
+        )
         return _per_node(results)
 
     return jobs.start("backup", work).as_dict()
 
 
-@router.post("/buses/{bus}/restore", response_model=JobModel, status_code=status.HTTP_202_ACCEPTED,
-             summary="Restore drives in parallel from DIRECTORY/node<N>/ (validated first, verified, stored)")
-def start_restore(bus: str, request: RestoreRequest, manager: ConnectionManager = Depends(get_connections),
-                  jobs: JobRegistry = Depends(get_jobs)) -> dict:
+@router.post(
+    "/buses/{bus}/restore",
+    response_model=JobModel,
+    status_code=status.HTTP_202_ACCEPTED,
+    summary="Restore drives in parallel from DIRECTORY/node<N>/ (validated first, verified, stored)",
+)
+def start_restore(
+    bus: str,
+    request: RestoreRequest,
+    manager: ConnectionManager = Depends(get_connections),
+    jobs: JobRegistry = Depends(get_jobs),
+) -> dict:
     connection = manager.get(bus)
     nodes, kinds, directory = _nodes(connection, request.nodes), _kinds(request.files), Path(request.directory)
 
@@ -71,8 +91,16 @@ def start_restore(bus: str, request: RestoreRequest, manager: ConnectionManager 
             for kind in chosen:
                 if cancel.requested:  # files not started are left out of the result
                     break
-                results.append(restore_file(drive, folder / kind.value, kind,
-                                            lambda event: progress({**event, "bus": bus}), request.store, cancel))
+                results.append(
+                    restore_file(
+                        drive,
+                        folder / kind.value,
+                        kind,
+                        lambda event: progress({**event, "bus": bus}),
+                        request.store,
+                        cancel,
+                    )
+                )
             return results
 
         return _per_node(run_per_drive([connection.drive(node) for node in nodes], restore_one))
@@ -95,8 +123,11 @@ def list_jobs(jobs: JobRegistry = Depends(get_jobs)) -> list[dict]:
     return [job.as_dict() for job in jobs.list()]
 
 
-@router.post("/jobs/{job_id}/cancel", response_model=JobModel,
-             summary="Cancel a running job: it stops at the next object or file boundary and ends 'cancelled'")
+@router.post(
+    "/jobs/{job_id}/cancel",
+    response_model=JobModel,
+    summary="Cancel a running job: it stops at the next object or file boundary and ends 'cancelled'",
+)
 def cancel_job(job_id: str, jobs: JobRegistry = Depends(get_jobs)) -> dict:
     job = jobs.cancel(job_id)
     if job is None:
@@ -112,8 +143,11 @@ def get_job(job_id: str, jobs: JobRegistry = Depends(get_jobs)) -> dict:
     return job.as_dict()
 
 
-@router.get("/buses/{bus}/nodes/{node}/files/{name}", response_class=PlainTextResponse,
-            summary="Back up one file of one drive and download it (DRIVEPAR.TXT, USER_PAR.TXT, SEQUENCE.TXT)")
+@router.get(
+    "/buses/{bus}/nodes/{node}/files/{name}",
+    response_class=PlainTextResponse,
+    summary="Back up one file of one drive and download it (DRIVEPAR.TXT, USER_PAR.TXT, SEQUENCE.TXT)",
+)
 def download_file(bus: str, node: int, name: str, manager: ConnectionManager = Depends(get_connections)) -> str:
     kind = _kinds([name])[0]
     drive = manager.get(bus).drive(node)
@@ -123,12 +157,21 @@ def download_file(bus: str, node: int, name: str, manager: ConnectionManager = D
         return path.read_text(encoding="latin-1")
 
 
-@router.put("/buses/{bus}/nodes/{node}/files/{name}",
-            summary="Upload a file and restore it to the drive (validated first; 422 names the line); with "
-                    "job=true as a cancellable job (202, progress on /api/ws/events)")
-def upload_file(bus: str, node: int, name: str, text: str = Body(..., media_type="text/plain"), store: bool = True,
-                job: bool = False, manager: ConnectionManager = Depends(get_connections),
-                jobs: JobRegistry = Depends(get_jobs)) -> dict:
+@router.put(
+    "/buses/{bus}/nodes/{node}/files/{name}",
+    summary="Upload a file and restore it to the drive (validated first; 422 names the line); with "
+    "job=true as a cancellable job (202, progress on /api/ws/events)",
+)
+def upload_file(
+    bus: str,
+    node: int,
+    name: str,
+    text: str = Body(..., media_type="text/plain"),
+    store: bool = True,
+    job: bool = False,
+    manager: ConnectionManager = Depends(get_connections),
+    jobs: JobRegistry = Depends(get_jobs),
+) -> dict:
     kind = _kinds([name])[0]
     drive = manager.get(bus).drive(node)
     if job:

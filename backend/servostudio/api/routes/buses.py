@@ -19,8 +19,12 @@ def list_buses(manager: ConnectionManager = Depends(get_connections)) -> list[di
     return [bus.status() for bus in manager.list()]
 
 
-@router.post("", response_model=BusStatus, status_code=status.HTTP_201_CREATED,
-             summary="Open a bus from a spec string (an existing bus with the same spec is returned)")
+@router.post(
+    "",
+    response_model=BusStatus,
+    status_code=status.HTTP_201_CREATED,
+    summary="Open a bus from a spec string (an existing bus with the same spec is returned)",
+)
 def open_bus(request: BusOpen, manager: ConnectionManager = Depends(get_connections)) -> dict:
     return manager.open(request.spec, request.id).status()
 
@@ -35,8 +39,11 @@ def close_bus(bus: str, manager: ConnectionManager = Depends(get_connections)) -
     manager.close(bus)
 
 
-@router.post("/{bus}/scan", response_model=list[NodeIdentity],
-             summary="Find and identify every node (1–127; 1–63 on a serial link)")
+@router.post(
+    "/{bus}/scan",
+    response_model=list[NodeIdentity],
+    summary="Find and identify every node (1–127; 1–63 on a serial link)",
+)
 def scan_bus(bus: str, manager: ConnectionManager = Depends(get_connections)) -> list[dict]:
     return [info.as_dict() for info in scan(manager.get(bus))]
 

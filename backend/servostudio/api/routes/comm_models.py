@@ -13,16 +13,29 @@ def _example(**values: Any) -> ConfigDict:
 
 class BusOpen(BaseModel):
     model_config = _example(spec="socketcand:127.0.0.1:29536", id="line1")
-    spec: str = Field(description="bus spec: socketcan:can0, pcan:PCAN_USBBUS1@1000000, ixxat:0@500000, kvaser:0, "
-                                   "slcan:/dev/ttyACM0@1000000, socketcand:HOST:PORT[/CH], virtual:NAME, "
-                                   "serial:PORT_OR_URL[@BAUD], sim[:NODES]")
-    id: str | None = Field(None, description="name of the bus in later calls (default: the bus kind, e.g. sim, socketcand, socketcand2, …)")
+    spec: str = Field(
+        description="bus spec: socketcan:can0, pcan:PCAN_USBBUS1@1000000, ixxat:0@500000, kvaser:0, "
+        "slcan:/dev/ttyACM0@1000000, socketcand:HOST:PORT[/CH], virtual:NAME, "
+        "serial:PORT_OR_URL[@BAUD], sim[:NODES]"
+    )
+    id: str | None = Field(
+        None, description="name of the bus in later calls (default: the bus kind, e.g. sim, socketcand, socketcand2, …)"
+    )
 
 
 class NodeIdentity(BaseModel):
-    model_config = _example(node=1, device="xtrapulspac", device_type=131474, vendor_id=130,
-                            product_code=1481654595, revision=0, serial_number=0, device_name="XtrapulsPac",
-                            hardware_version="", software_version="")
+    model_config = _example(
+        node=1,
+        device="xtrapulspac",
+        device_type=131474,
+        vendor_id=130,
+        product_code=1481654595,
+        revision=0,
+        serial_number=0,
+        device_name="XtrapulsPac",
+        hardware_version="",
+        software_version="",
+    )
     node: int
     device: str | None = None
     device_type: int | None = None
@@ -59,9 +72,20 @@ class BitValue(BaseModel):
 
 
 class ObjectValueModel(BaseModel):
-    model_config = _example(node=1, index=0x6060, sub=0, name="Modes of operation", label="0x6060,0 Modes of operation",
-                            data_type="INTEGER8", access="rw", raw=1, physical=1, unit="", text="Profile position",
-                            bits=[])
+    model_config = _example(
+        node=1,
+        index=0x6060,
+        sub=0,
+        name="Modes of operation",
+        label="0x6060,0 Modes of operation",
+        data_type="INTEGER8",
+        access="rw",
+        raw=1,
+        physical=1,
+        unit="",
+        text="Profile position",
+        bits=[],
+    )
     node: int
     index: int
     sub: int
@@ -95,8 +119,9 @@ class ReadResult(BaseModel):
 
 class StateRequest(BaseModel):
     model_config = _example(target="operation-enabled")
-    target: str = Field(description="switch-on-disabled | ready-to-switch-on | switched-on | operation-enabled | "
-                                    "quick-stop-active")
+    target: str = Field(
+        description="switch-on-disabled | ready-to-switch-on | switched-on | operation-enabled | quick-stop-active"
+    )
 
 
 class DriveState(BaseModel):
@@ -115,9 +140,18 @@ class FaultInfoModel(BaseModel):
 
 
 class FaultReportModel(BaseModel):
-    model_config = _example(node=1, state="FAULT", statusword=0x0208, fault=True, error_code=0x8611,
-                            error_text="following error", faults=[{"code": 35, "cia402_code": 0x8611,
-                            "name": "Position following error", "remedy": "Check that the load …"}], warnings=[])
+    model_config = _example(
+        node=1,
+        state="FAULT",
+        statusword=0x0208,
+        fault=True,
+        error_code=0x8611,
+        error_text="following error",
+        faults=[
+            {"code": 35, "cia402_code": 0x8611, "name": "Position following error", "remedy": "Check that the load …"}
+        ],
+        warnings=[],
+    )
     node: int
     state: str | None
     statusword: int
@@ -132,8 +166,9 @@ class BackupRequest(BaseModel):
     model_config = _example(directory="projects/line1/backup", nodes=[1, 2], files=["DRIVEPAR.TXT"])
     directory: str = Field(description="server-side directory; each node's files go to DIRECTORY/node<N>/")
     nodes: list[int] | None = Field(None, description="default: every node found by the last scan")
-    files: list[str] | None = Field(None, description="DRIVEPAR.TXT, USER_PAR.TXT, SEQUENCE.TXT (default: all the "
-                                                      "device has)")
+    files: list[str] | None = Field(
+        None, description="DRIVEPAR.TXT, USER_PAR.TXT, SEQUENCE.TXT (default: all the device has)"
+    )
 
 
 class RestoreRequest(BackupRequest):
@@ -141,8 +176,9 @@ class RestoreRequest(BackupRequest):
 
 
 class JobModel(BaseModel):
-    model_config = _example(id="job1", operation="backup", state="running", result=None, error=None,
-                            started=1763771000.0, finished=None)
+    model_config = _example(
+        id="job1", operation="backup", state="running", result=None, error=None, started=1763771000.0, finished=None
+    )
     id: str
     operation: str
     state: str

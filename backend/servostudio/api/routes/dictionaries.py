@@ -86,12 +86,24 @@ def _summary(library: EdsLibrary, od: ObjectDictionary) -> dict:
 def _entry(var: Variable) -> EntryModel:
     default = var.default.hex() if isinstance(var.default, bytes) else var.default
     return EntryModel(
-        subindex=var.subindex, name=var.name, data_type=var.data_type.name, access=var.access.value,
-        pdo_mappable=var.pdo_mappable, low=var.low, high=var.high, default=default, unit=var.unit,
-        scale=var.scale, offset=var.offset, save_type=var.save_type.value, group=var.group,
-        description=var.description, enum={str(value): text for value, text in var.enum.items()},
+        subindex=var.subindex,
+        name=var.name,
+        data_type=var.data_type.name,
+        access=var.access.value,
+        pdo_mappable=var.pdo_mappable,
+        low=var.low,
+        high=var.high,
+        default=default,
+        unit=var.unit,
+        scale=var.scale,
+        offset=var.offset,
+        save_type=var.save_type.value,
+        group=var.group,
+        description=var.description,
+        enum={str(value): text for value, text in var.enum.items()},
         bits=[BitFieldModel(first=b.first, last=b.last, name=b.name) for b in var.bits],
-        is_pointer=var.is_pointer, reference=var.reference,
+        is_pointer=var.is_pointer,
+        reference=var.reference,
     )
 
 
@@ -111,8 +123,13 @@ def list_dictionaries(library: Library, _: Caller) -> list[dict]:
 def get_dictionary(device: str, library: Library, _: Caller) -> DictionaryModel:
     od = _load(library, device)
     objects = [
-        ObjectModel(index=obj.index, name=obj.name, kind=obj.kind.value, group=obj.group,
-                    subs=[_entry(var) for _, var in sorted(obj.subs.items())])
+        ObjectModel(
+            index=obj.index,
+            name=obj.name,
+            kind=obj.kind.value,
+            group=obj.group,
+            subs=[_entry(var) for _, var in sorted(obj.subs.items())],
+        )
         for obj in od.objects()
     ]
     groups = list(dict.fromkeys(obj.group for obj in od.objects() if obj.group))

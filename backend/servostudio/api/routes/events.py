@@ -27,9 +27,14 @@ router = APIRouter(tags=["events"])
 
 
 @router.websocket("/ws/events")
-async def events_socket(socket: WebSocket, types: str | None = None, user: User = Depends(current_user),
-                        hub: EventHub = Depends(get_events), motion: MotionGuard = Depends(get_motion),
-                        manager: ConnectionManager = Depends(get_connections)) -> None:
+async def events_socket(
+    socket: WebSocket,
+    types: str | None = None,
+    user: User = Depends(current_user),
+    hub: EventHub = Depends(get_events),
+    motion: MotionGuard = Depends(get_motion),
+    manager: ConnectionManager = Depends(get_connections),
+) -> None:
     """Events as they happen. The socket is also the caller's motion client: its first message,
     ``{"type": "hello", "client": ID}``, gives the id that enabling a drive must name (X-Servo-Client), and the
     axes it enabled get a quick stop when the socket closes."""
@@ -62,9 +67,12 @@ async def _drain(socket: WebSocket) -> None:
 
 
 @router.websocket("/ws/terminal")
-async def terminal_socket(socket: WebSocket, user: User = Depends(current_user),
-                          manager: ConnectionManager = Depends(get_connections),
-                          motion: MotionGuard = Depends(get_motion)) -> None:
+async def terminal_socket(
+    socket: WebSocket,
+    user: User = Depends(current_user),
+    manager: ConnectionManager = Depends(get_connections),
+    motion: MotionGuard = Depends(get_motion),
+) -> None:
     await socket.accept()
     monitor: asyncio.Task | None = None
     try:
@@ -73,9 +81,17 @@ async def terminal_socket(socket: WebSocket, user: User = Depends(current_user),
             try:
                 operation = message.get("op")
                 if operation == "write":
-                    value = await asyncio.to_thread(write, manager, motion, message.get("client"),
-                                                    message["bus"], int(message["node"]), str(message["object"]),
-                                                    message["value"], bool(message.get("physical", False)))
+                    value = await asyncio.to_thread(
+                        write,
+                        manager,
+                        motion,
+                        message.get("client"),
+                        message["bus"],
+                        int(message["node"]),
+                        str(message["object"]),
+                        message["value"],
+                        bool(message.get("physical", False)),
+                    )
                     await socket.send_json({"type": "written", "value": value})
                 elif operation in ("read", "watch"):
                     watch = _watch(message)
@@ -101,8 +117,9 @@ async def terminal_socket(socket: WebSocket, user: User = Depends(current_user),
 
 
 def _watch(message: dict) -> Watch:
-    items = tuple(WatchItem(str(item["bus"]), int(item["node"]), str(item["object"]))
-                  for item in message.get("items", []))
+    items = tuple(
+        WatchItem(str(item["bus"]), int(item["node"]), str(item["object"])) for item in message.get("items", [])
+    )
     return Watch(items, float(message.get("period_ms", 200)) / 1000)
 
 

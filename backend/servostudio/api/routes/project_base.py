@@ -13,9 +13,16 @@ from servostudio.api.deps import User, current_user
 from servostudio.services.projects import ProjectService, errors
 
 _STATUS = {
-    errors.ProjectNotFound: 404, errors.ProjectExists: 409, errors.ConflictError: 409, errors.InvalidName: 422,
-    errors.ValidationError: 422, errors.ParameterRefused: 422, errors.ArchiveError: 422,
-    errors.FileFormatError: 422, errors.DriveMismatch: 409, errors.DriveUnavailable: 503,
+    errors.ProjectNotFound: 404,
+    errors.ProjectExists: 409,
+    errors.ConflictError: 409,
+    errors.InvalidName: 422,
+    errors.ValidationError: 422,
+    errors.ParameterRefused: 422,
+    errors.ArchiveError: 422,
+    errors.FileFormatError: 422,
+    errors.DriveMismatch: 409,
+    errors.DriveUnavailable: 503,
 }
 
 

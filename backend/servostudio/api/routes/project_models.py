@@ -111,8 +111,9 @@ class CompareRowModel(BaseModel):
     name: str
     group: str
     unit: str
-    values: dict[str, Scalar] = Field(description="column -> value; columns drive (with ?drive=true) / project / "
-                                                  "default")
+    values: dict[str, Scalar] = Field(
+        description="column -> value; columns drive (with ?drive=true) / project / default"
+    )
     differs: bool
 
 
@@ -132,8 +133,9 @@ class AxisChoiceModel(BaseModel):
 class MotorChoice(BaseModel):
     reference: str
     revision: str | None = None
-    drive: bool = Field(default=False, description="write the motor to the axis's live drive and read back what "
-                        "the drive derived")
+    drive: bool = Field(
+        default=False, description="write the motor to the axis's live drive and read back what the drive derived"
+    )
 
 
 class TemplateChoice(BaseModel):
@@ -167,6 +169,7 @@ class MotorModel(BaseModel):
 
 # ---- conversions (the dict views are shared with the CLI) ---------------------------------------------------------
 
+
 def project_model(snapshot: Snapshot) -> ProjectModel:
     return ProjectModel(**project_view(snapshot))
 
@@ -177,4 +180,3 @@ def parameter_model(row: ParameterRow) -> ParameterModel:
 
 def buses_from(models: list[BusModel]) -> tuple[Bus, ...]:
     return tuple(Bus(b.name, b.interface, b.bitrate) for b in models)
-

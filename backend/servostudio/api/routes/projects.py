@@ -62,6 +62,7 @@ Connections = Annotated[ConnectionManager, Depends(get_connections)]
 
 # ---- projects ---------------------------------------------------------------------------------------------------
 
+
 @router.get("/projects", response_model=list[ProjectSummary])
 def list_projects(service: Service, _: Caller) -> list[ProjectSummary]:
     return [ProjectSummary(**summary) for summary in summaries(service.store)]
@@ -73,8 +74,9 @@ def create_project(body: ProjectCreate, service: Service, _: Caller) -> ProjectM
 
 
 @router.post("/projects/unarchive", response_model=ProjectModel, status_code=201)
-async def unarchive(request: Request, service: Service, _: Caller,
-                    new_name: Annotated[str | None, Query()] = None) -> Response:
+async def unarchive(
+    request: Request, service: Service, _: Caller, new_name: Annotated[str | None, Query()] = None
+) -> Response:
     """Body: the zip archive (``application/zip``). Its size is limited before anything is unpacked."""
     limits = ArchiveLimits()
     with tempfile.TemporaryDirectory() as scratch:
@@ -84,8 +86,13 @@ async def unarchive(request: Request, service: Service, _: Caller,
             async for chunk in request.stream():
                 size += len(chunk)
                 if size > limits.max_total_bytes:
-                    return JSONResponse(status_code=413, content={
-                        "detail": f"archive larger than {limits.max_total_bytes} bytes", "error": "ArchiveError"})
+                    return JSONResponse(
+                        status_code=413,
+                        content={
+                            "detail": f"archive larger than {limits.max_total_bytes} bytes",
+                            "error": "ArchiveError",
+                        },
+                    )
                 stream.write(chunk)
         snapshot = await run_in_threadpool(service.unarchive, path, new_name, limits)
     return JSONResponse(status_code=201, content=project_model(snapshot).model_dump())
@@ -122,8 +129,9 @@ def duplicate_project(name: str, body: NewName, service: Service, _: Caller) -> 
 def archive_project(name: str, service: Service, _: Caller) -> FileResponse:
     scratch = tempfile.mkdtemp()
     path = service.archive(name, Path(scratch) / f"{name}.zip")
-    return FileResponse(path, media_type="application/zip", filename=f"{name}.zip",
-                        background=BackgroundTask(_remove_tree, scratch))
+    return FileResponse(
+        path, media_type="application/zip", filename=f"{name}.zip", background=BackgroundTask(_remove_tree, scratch)
+    )
 
 
 def _remove_tree(path: str) -> None:
@@ -131,6 +139,7 @@ def _remove_tree(path: str) -> None:
 
 
 # ---- axes -------------------------------------------------------------------------------------------------------
+
 
 @router.post("/projects/{name}/axes", response_model=ProjectModel, status_code=201)
 def add_axis(name: str, body: AxisCreate, service: Service, _: Caller) -> ProjectModel:
@@ -150,11 +159,19 @@ def remove_axis(name: str, axis: str, service: Service, _: Caller, revision: str
 
 
 @router.get("/projects/{name}/axes/{axis}/parameters", response_model=ParameterList)
-def list_parameters(name: str, axis: str, service: Service, _: Caller, group: str | None = None,
-                    only_set: bool = False, only_differences: bool = False,
-                    include_unsaved: bool = False) -> ParameterList:
-    rows, revision = service.parameters.rows(name, axis, group=group, only_set=only_set,
-                                             only_differences=only_differences, include_unsaved=include_unsaved)
+def list_parameters(
+    name: str,
+    axis: str,
+    service: Service,
+    _: Caller,
+    group: str | None = None,
+    only_set: bool = False,
+    only_differences: bool = False,
+    include_unsaved: bool = False,
+) -> ParameterList:
+    rows, revision = service.parameters.rows(
+        name, axis, group=group, only_set=only_set, only_differences=only_differences, include_unsaved=include_unsaved
+    )
     return ParameterList(parameters=[parameter_model(row) for row in rows], revision=revision)
 
 
@@ -177,22 +194,38 @@ def reset_parameters(name: str, axis: str, body: ParameterReset, service: Servic
 
 
 @router.get("/projects/{name}/axes/{axis}/compare", response_model=CompareModel)
-def compare_axis(name: str, axis: str, service: Service, connections: Connections, _: Caller,
-                 group: str | None = None, only_differences: bool = False, drive: bool = False) -> CompareModel:
+def compare_axis(
+    name: str,
+    axis: str,
+    service: Service,
+    connections: Connections,
+    _: Caller,
+    group: str | None = None,
+    only_differences: bool = False,
+    drive: bool = False,
+) -> CompareModel:
     """Project / default columns; with ``drive=true`` drive / project / default, read from the axis's live drive
     (its bus is opened on the server if needed), and a row differs when the drive's value is not the project's."""
     if not drive:
         rows, revision = service.parameters.compare(name, axis, group=group, only_differences=only_differences)
-        return CompareModel(columns=["project", "default"], revision=revision,
-                            rows=[CompareRowModel(**compare_view(row)) for row in rows])
+        return CompareModel(
+            columns=["project", "default"],
+            revision=revision,
+            rows=[CompareRowModel(**compare_view(row)) for row in rows],
+        )
     live = LiveProjects(service, connections).compare(name, axis, group=group, only_differences=only_differences)
-    return CompareModel(columns=["drive", "project", "default"], revision=live.revision, refused=live.refused,
-                        rows=[CompareRowModel(**compare_view(row)) for row in live.rows])
+    return CompareModel(
+        columns=["drive", "project", "default"],
+        revision=live.revision,
+        refused=live.refused,
+        rows=[CompareRowModel(**compare_view(row)) for row in live.rows],
+    )
 
 
 @router.post("/projects/{name}/axes/{axis}/motor", response_model=AxisChoiceModel)
-def select_motor(name: str, axis: str, body: MotorChoice, service: Service, connections: Connections,
-                 _: Caller) -> AxisChoiceModel:
+def select_motor(
+    name: str, axis: str, body: MotorChoice, service: Service, connections: Connections, _: Caller
+) -> AxisChoiceModel:
     """Offline: the project reproduces the drive's side effects. With ``drive: true`` the motor is written to the
     axis's live drive and the values the drive derived are read back into the project."""
     if body.drive:
@@ -216,11 +249,15 @@ def apply_application(name: str, axis: str, body: TemplateChoice, service: Servi
 @router.get("/projects/{name}/axes/{axis}/dcf")
 def export_dcf(name: str, axis: str, service: Service, _: Caller) -> Response:
     text = service.dcf(name, axis)
-    return Response(text.encode("latin-1"), media_type="text/plain; charset=latin-1",
-                    headers={"Content-Disposition": f'attachment; filename="{axis}.dcf"'})
+    return Response(
+        text.encode("latin-1"),
+        media_type="text/plain; charset=latin-1",
+        headers={"Content-Disposition": f'attachment; filename="{axis}.dcf"'},
+    )
 
 
 # ---- catalog and templates --------------------------------------------------------------------------------------
+
 
 @router.get("/motors", response_model=list[MotorModel])
 def list_motors(service: Service, _: Caller) -> list[MotorModel]:
@@ -229,14 +266,14 @@ def list_motors(service: Service, _: Caller) -> list[MotorModel]:
 
 @router.post("/motors", response_model=MotorModel, status_code=201)
 def add_motor(body: MotorModel, service: Service, _: Caller) -> MotorModel:
-    """"Add new motor": a user catalog entry (built-in references cannot be reused)."""
+    """ "Add new motor": a user catalog entry (built-in references cannot be reused)."""
     objects = {}
     for key, value in body.objects.items():
         index, _sep, sub = key.partition(",")
         try:
             objects[(int(index, 16), int(sub))] = value
         except ValueError:
-            raise errors.ValidationError(f"object key {key!r} must look like \"0x3324,1\"") from None
+            raise errors.ValidationError(f'object key {key!r} must look like "0x3324,1"') from None
     motor = Motor(body.reference, body.description, body.source, dict(body.motor_data), objects)
     return MotorModel(**motor_view(service.motors.add(motor)))
 

@@ -26,14 +26,18 @@ Jobs = Annotated[JobRegistry, Depends(get_jobs)]
 
 
 class TakeRequest(BaseModel):
-    addresses: list[str] | None = Field(default=None, description="objects to take; null = every object whose "
-                                        "drive value differs from the project's", examples=[["0x6060", "0x60F9,2"]])
+    addresses: list[str] | None = Field(
+        default=None,
+        description="objects to take; null = every object whose drive value differs from the project's",
+        examples=[["0x6060", "0x60F9,2"]],
+    )
     revision: str | None = None
 
 
 class WriteRequest(BaseModel):
-    addresses: list[str] | None = Field(default=None, description="objects to write; null = every object whose "
-                                        "drive value differs from the project's")
+    addresses: list[str] | None = Field(
+        default=None, description="objects to write; null = every object whose drive value differs from the project's"
+    )
     store: bool = Field(default=False, description="save the drive's parameters to flash afterwards")
 
 
@@ -55,15 +59,19 @@ class DriveWriteReportModel(BaseModel):
 
 class CommissionRequest(BaseModel):
     direction: Literal["check", "download", "upload"] = Field(
-        default="check", description="check: identify every axis's drive; download: project → drives (validated, "
-        "written, verified, stored); upload: drives → project files")
+        default="check",
+        description="check: identify every axis's drive; download: project → drives (validated, "
+        "written, verified, stored); upload: drives → project files",
+    )
     axes: list[str] | None = Field(default=None, description="axes to commission; null = all")
     revision: str | None = None
 
 
 class ScanRequest(BaseModel):
-    bus: str = Field(examples=["sim", "socketcand:127.0.0.1:29536"], description="a bus of the project (name) or "
-                     "a bus spec; a new spec is added to the project as a bus")
+    bus: str = Field(
+        examples=["sim", "socketcand:127.0.0.1:29536"],
+        description="a bus of the project (name) or a bus spec; a new spec is added to the project as a bus",
+    )
     bus_name: str | None = Field(default=None, description="name of the new bus (default: derived from the spec)")
     create: bool = Field(default=False, description="create the project if it does not exist")
     revision: str | None = None
@@ -86,16 +94,18 @@ class ScanResultModel(BaseModel):
 
 
 @router.post("/projects/{name}/axes/{axis}/take-from-drive", response_model=ParameterList)
-def take_from_drive(name: str, axis: str, body: TakeRequest, service: Service, connections: Connections,
-                    _: Caller) -> ParameterList:
+def take_from_drive(
+    name: str, axis: str, body: TakeRequest, service: Service, connections: Connections, _: Caller
+) -> ParameterList:
     """Store the drive's values in the project (checked like offline edits; all or nothing)."""
     change = LiveProjects(service, connections).take(name, axis, body.addresses, body.revision)
     return ParameterList(parameters=[parameter_model(row) for row in change.rows], revision=change.revision)
 
 
 @router.post("/projects/{name}/axes/{axis}/write-to-drive", response_model=DriveWriteReportModel)
-def write_to_drive(name: str, axis: str, body: WriteRequest, service: Service, connections: Connections,
-                   _: Caller) -> DriveWriteReportModel:
+def write_to_drive(
+    name: str, axis: str, body: WriteRequest, service: Service, connections: Connections, _: Caller
+) -> DriveWriteReportModel:
     """Write the project's values to the drive; every value is checked like an online write before the first is
     sent, so one bad value writes nothing (422)."""
     report = LiveProjects(service, connections).write(name, axis, body.addresses, body.store)
@@ -103,25 +113,31 @@ def write_to_drive(name: str, axis: str, body: WriteRequest, service: Service, c
 
 
 @router.post("/projects/{name}/commission", response_model=JobModel, status_code=status.HTTP_202_ACCEPTED)
-def start_commission(name: str, body: CommissionRequest, service: Service, connections: Connections, jobs: Jobs,
-                     _: Caller) -> dict:
+def start_commission(
+    name: str, body: CommissionRequest, service: Service, connections: Connections, jobs: Jobs, _: Caller
+) -> dict:
     """Runs as a job: follow ``progress`` and ``job`` events on ``/api/ws/events`` or poll ``GET /api/jobs/{id}``;
     the result is the report per axis (status ok / bus_down / no_answer / wrong_device, files restored or read)."""
     service.store.open(name)  # an unknown project is refused now (404), not in the job
     live = LiveProjects(service, connections)
 
     def work(progress, cancel) -> dict:
-        return live.commission(name, body.direction, body.axes, body.revision, progress=progress,
-                               cancel=cancel).as_dict()
+        return live.commission(
+            name, body.direction, body.axes, body.revision, progress=progress, cancel=cancel
+        ).as_dict()
 
     return jobs.start(f"commission-{body.direction}", work).as_dict()
 
 
 @router.post("/projects/{name}/scan", response_model=ScanResultModel)
-def scan_into_project(name: str, body: ScanRequest, service: Service, connections: Connections,
-                      _: Caller) -> ScanResultModel:
+def scan_into_project(
+    name: str, body: ScanRequest, service: Service, connections: Connections, _: Caller
+) -> ScanResultModel:
     """Scan a bus and add an axis for every identified node not yet in the project (one project change)."""
     report = LiveProjects(service, connections).scan(name, body.bus, body.bus_name, body.revision, body.create)
-    return ScanResultModel(bus=report.bus.name, bus_added=report.bus_added,
-                           nodes=[ScannedNodeModel(**node.as_dict()) for node in report.nodes],
-                           project=project_model(report.snapshot))
+    return ScanResultModel(
+        bus=report.bus.name,
+        bus_added=report.bus_added,
+        nodes=[ScannedNodeModel(**node.as_dict()) for node in report.nodes],
+        project=project_model(report.snapshot),
+    )

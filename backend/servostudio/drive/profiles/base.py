@@ -112,5 +112,8 @@ class DeviceProfile:
 
 def generic_profile(device: str) -> DeviceProfile:
     """Plain CiA 301 + 402: standard objects and the standard 'save' signature."""
-    return DeviceProfile(device=device, objects={**CIA301_OBJECTS, **CIA402_OBJECTS},
-                         signatures={"save": ("store_parameters", "save"), "load": ("restore_parameters", "load")})
+    return DeviceProfile(
+        device=device,
+        objects={**CIA301_OBJECTS, **CIA402_OBJECTS},
+        signatures={"save": ("store_parameters", "save"), "load": ("restore_parameters", "load")},
+    )

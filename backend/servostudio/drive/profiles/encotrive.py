@@ -8,25 +8,35 @@ from __future__ import annotations
 from servostudio.drive.faults import FaultInfo
 from servostudio.drive.profiles.base import CIA301_OBJECTS, CIA402_OBJECTS, Addressing, DeviceProfile
 
-_EMCY = {info.cia402_code: info for info in (
-    FaultInfo(0, 0x4280, "CPU-board temperature sensor failed", "The drive switched off; reset with control word bit 7 "
-              "once the sensor works."),
-    FaultInfo(0, 0x4290, "CPU-board over-temperature (warning)", "Clears by itself below the warning threshold."),
-    FaultInfo(0, 0x4310, "Power-stage over-temperature", ""),
-    FaultInfo(0, 0x6343, "Ramp positioning lasted longer than the maximum ramp duration", ""),
-    FaultInfo(0, 0x8100, "Communication error", ""),
-    FaultInfo(0, 0x8110, "CAN buffer overflow or wrong state (e.g. TPDO rate too high)", ""),
-    FaultInfo(0, 0x8120, "CAN error-passive", ""),
-    FaultInfo(0, 0x8130, "Life-guard or heartbeat error", ""),
-    FaultInfo(0, 0x8140, "CAN active again after bus-off", "Not cleared automatically."),
-    FaultInfo(0, 0x8150, "COB-ID collision", "A SYNC/PDO COB-ID is used twice on the node; reception is blocked."),
-    FaultInfo(0, 0x8200, "Protocol error", ""),
-    FaultInfo(0, 0x8210, "PDO ignored (length error)", ""),
-    FaultInfo(0, 0x8220, "PDO length exceeded", ""),
-    FaultInfo(0, 0x8611, "Following error", "The error exceeded 0x6065 for longer than 0x6066; check the supply "
-              "voltage "
-              "and the load."),
-)}
+_EMCY = {
+    info.cia402_code: info
+    for info in (
+        FaultInfo(
+            0,
+            0x4280,
+            "CPU-board temperature sensor failed",
+            "The drive switched off; reset with control word bit 7 once the sensor works.",
+        ),
+        FaultInfo(0, 0x4290, "CPU-board over-temperature (warning)", "Clears by itself below the warning threshold."),
+        FaultInfo(0, 0x4310, "Power-stage over-temperature", ""),
+        FaultInfo(0, 0x6343, "Ramp positioning lasted longer than the maximum ramp duration", ""),
+        FaultInfo(0, 0x8100, "Communication error", ""),
+        FaultInfo(0, 0x8110, "CAN buffer overflow or wrong state (e.g. TPDO rate too high)", ""),
+        FaultInfo(0, 0x8120, "CAN error-passive", ""),
+        FaultInfo(0, 0x8130, "Life-guard or heartbeat error", ""),
+        FaultInfo(0, 0x8140, "CAN active again after bus-off", "Not cleared automatically."),
+        FaultInfo(0, 0x8150, "COB-ID collision", "A SYNC/PDO COB-ID is used twice on the node; reception is blocked."),
+        FaultInfo(0, 0x8200, "Protocol error", ""),
+        FaultInfo(0, 0x8210, "PDO ignored (length error)", ""),
+        FaultInfo(0, 0x8220, "PDO length exceeded", ""),
+        FaultInfo(
+            0,
+            0x8611,
+            "Following error",
+            "The error exceeded 0x6065 for longer than 0x6066; check the supply voltage and the load.",
+        ),
+    )
+}
 
 ENCOTRIVE = DeviceProfile(
     device="encotrive",

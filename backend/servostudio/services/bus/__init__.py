@@ -4,5 +4,13 @@ from servostudio.services.bus.connections import BusConnection, ConnectionManage
 from servostudio.services.bus.events import EventHub, Subscription
 from servostudio.services.bus.jobs import Job, JobRegistry
 
-__all__ = ["BusConnection", "ConnectionManager", "EventHub", "Job", "JobRegistry", "NodeInfo", "Subscription",
-           "UnknownBusOrNode"]
+__all__ = [
+    "BusConnection",
+    "ConnectionManager",
+    "EventHub",
+    "Job",
+    "JobRegistry",
+    "NodeInfo",
+    "Subscription",
+    "UnknownBusOrNode",
+]

@@ -102,9 +102,14 @@ class BusConnection:
         return profile_for(info.device) if info and info.device else None
 
     def status(self) -> dict[str, object]:
-        return {"id": self.id, "spec": str(self.spec), "kind": self.spec.kind, "connected": self.link.connected,
-                "error": self.link.last_error or None,
-                "nodes": [info.as_dict() for info in sorted(self.nodes.values(), key=lambda item: item.node)]}
+        return {
+            "id": self.id,
+            "spec": str(self.spec),
+            "kind": self.spec.kind,
+            "connected": self.link.connected,
+            "error": self.link.last_error or None,
+            "nodes": [info.as_dict() for info in sorted(self.nodes.values(), key=lambda item: item.node)],
+        }
 
     def close(self) -> None:
         self.link.close()
@@ -134,12 +139,16 @@ class ConnectionManager:
         opener, simulation = self._opener(spec)
         link = BusLink(bus_id, opener)
         timeout = SERIAL_SDO_TIMEOUT if spec.kind == "serial" else CAN_SDO_TIMEOUT
-        connection = BusConnection(bus_id, spec, link, SdoEngine(link, timeout), self.library, self.events,
-                                   simulation=simulation)
+        connection = BusConnection(
+            bus_id, spec, link, SdoEngine(link, timeout), self.library, self.events, simulation=simulation
+        )
         connection.monitor = BusMonitor(link, self.events.publish, connection.profile_of)
         StatuswordWatch(connection, lambda: self.events.wants("drive_state"))
-        link.on_state(lambda connected, reason: self.events.publish(
-            {"type": "bus_state", "bus": bus_id, "connected": connected, "reason": reason}))
+        link.on_state(
+            lambda connected, reason: self.events.publish(
+                {"type": "bus_state", "bus": bus_id, "connected": connected, "reason": reason}
+            )
+        )
         with self._lock:
             self._buses[bus_id] = connection
         link.start(wait)

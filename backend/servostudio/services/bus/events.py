@@ -58,8 +58,9 @@ class EventHub:
     def wants(self, event_type: str) -> bool:
         """Whether a subscriber would receive events of this type (lets a publisher skip costly work)."""
         with self._lock:
-            return any(subscription.types is None or event_type in subscription.types
-                       for subscription in self._subscriptions)
+            return any(
+                subscription.types is None or event_type in subscription.types for subscription in self._subscriptions
+            )
 
     def add_listener(self, listener: Callable[[dict[str, object]], None]) -> None:
         """A plain callback run in the publisher's thread (CLI progress, tests)."""

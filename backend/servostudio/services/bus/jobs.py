@@ -33,8 +33,15 @@ class Job:
     cancellation: Cancellation = field(default_factory=Cancellation, repr=False)
 
     def as_dict(self) -> dict[str, object]:
-        return {"id": self.id, "operation": self.operation, "state": self.state, "result": self.result,
-                "error": self.error or None, "started": self.started, "finished": self.finished}
+        return {
+            "id": self.id,
+            "operation": self.operation,
+            "state": self.state,
+            "result": self.result,
+            "error": self.error or None,
+            "started": self.started,
+            "finished": self.finished,
+        }
 
 
 class JobRegistry:

@@ -37,7 +37,7 @@ class ArchiveLimits:
     max_member_bytes: int = 16 * 1024 * 1024
     max_total_bytes: int = 64 * 1024 * 1024
     max_members: int = 10_000
-    max_ratio: int = 200          # inflated / compressed bytes per member; text compresses ~5-20x
+    max_ratio: int = 200  # inflated / compressed bytes per member; text compresses ~5-20x
 
 
 DEFAULT_LIMITS = ArchiveLimits()
@@ -62,9 +62,13 @@ def archive_project(store: ProjectStore, name: str, destination: Path) -> Path:
     return destination
 
 
-def unarchive_project(store: ProjectStore, source: Path, new_name: str | None = None,
-                      limits: ArchiveLimits = DEFAULT_LIMITS,
-                      verify: Callable[[Path, Project], None] | None = None) -> Snapshot:
+def unarchive_project(
+    store: ProjectStore,
+    source: Path,
+    new_name: str | None = None,
+    limits: ArchiveLimits = DEFAULT_LIMITS,
+    verify: Callable[[Path, Project], None] | None = None,
+) -> Snapshot:
     """Unpack a project archive into the store (as ``new_name`` if given) and return it opened.
 
     ``verify(directory, project)`` may check the unpacked axis files before the project is accepted.
@@ -111,16 +115,22 @@ def _check_members(archive: zipfile.ZipFile, source: Path, limits: ArchiveLimits
         if info.flag_bits & 0x1:
             raise ArchiveError(f"{source}: member '{info.filename}' is encrypted")
         if info.file_size > limits.max_member_bytes:
-            raise ArchiveError(f"{source}: member '{info.filename}' is {info.file_size} bytes, more than the limit "
-                               f"of {limits.max_member_bytes}")
+            raise ArchiveError(
+                f"{source}: member '{info.filename}' is {info.file_size} bytes, more than the limit "
+                f"of {limits.max_member_bytes}"
+            )
         if info.file_size > limits.max_ratio * info.compress_size + _CHUNK:
-            raise ArchiveError(f"{source}: member '{info.filename}' inflates {info.compress_size} to "
-                               f"{info.file_size} bytes; refusing a zip bomb")
+            raise ArchiveError(
+                f"{source}: member '{info.filename}' inflates {info.compress_size} to "
+                f"{info.file_size} bytes; refusing a zip bomb"
+            )
         tops.add(parts[0])
     declared = sum(info.file_size for info in members)
     if declared > limits.max_total_bytes:
-        raise ArchiveError(f"{source}: the members add up to {declared} bytes, more than the limit of "
-                           f"{limits.max_total_bytes}; refusing a zip bomb")
+        raise ArchiveError(
+            f"{source}: the members add up to {declared} bytes, more than the limit of "
+            f"{limits.max_total_bytes}; refusing a zip bomb"
+        )
     if len(tops) != 1:
         raise ArchiveError(f"{source}: expected one top-level project directory, found {', '.join(sorted(tops))}")
     return tops.pop()

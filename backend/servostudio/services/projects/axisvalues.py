@@ -23,8 +23,15 @@ from servostudio.formats.textfile import FILE_ENCODING
 from servostudio.od import ObjectDictionary, OutOfRange, SaveType, Variable, WrongType
 from servostudio.services.projects.devices import parameter_files
 from servostudio.services.projects.errors import FileFormatError, ParameterRefused
+from servostudio.services.projects.parameter_values import (
+    BadValue,
+    Value,
+    coerce,
+    from_file_value,
+    normalize,
+    to_file_value,
+)
 from servostudio.services.projects.store import ProjectEdit
-from servostudio.services.projects.values import BadValue, Value, coerce, from_file_value, normalize, to_file_value
 
 Key = tuple[int, int]
 
@@ -34,8 +41,10 @@ def editable_reason(variable: Variable, files: Mapping[str, SaveType]) -> str | 
     if not variable.access.writable:
         return f"{variable.label} is read-only ({variable.access.value})"
     if variable.save_type not in files.values():
-        return (f"{variable.label} is not saved in a drive file (save type {variable.save_type.value}); "
-                "it can only be written to a live drive")
+        return (
+            f"{variable.label} is not saved in a drive file (save type {variable.save_type.value}); "
+            "it can only be written to a live drive"
+        )
     if variable.data_type.is_binary:
         return f"{variable.label}: {variable.data_type.name} values cannot be edited offline"
     return None
@@ -73,8 +82,11 @@ class AxisValues:
     def transferable(self) -> list[Variable]:
         """The objects a drive and the project exchange (download writes them, upload reads them): editable offline
         and readable from the drive, in dictionary order."""
-        return [variable for variable in self.dictionary.variables()
-                if variable.access.readable and self.editable_reason(variable) is None]
+        return [
+            variable
+            for variable in self.dictionary.variables()
+            if variable.access.readable and self.editable_reason(variable) is None
+        ]
 
     # ---- reading ---------------------------------------------------------------------------------------------
 

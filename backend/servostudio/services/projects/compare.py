@@ -16,7 +16,7 @@ from typing import Protocol
 
 from servostudio.od import ObjectDictionary, Variable
 from servostudio.services.projects.axisvalues import AxisValues
-from servostudio.services.projects.values import Value, normalize
+from servostudio.services.projects.parameter_values import Value, normalize
 
 
 class ParameterSource(Protocol):
@@ -49,13 +49,18 @@ class ProjectValues:
 @dataclass(frozen=True)
 class CompareRow:
     variable: Variable
-    values: dict[str, Value | None]     # column name -> value (normalized)
+    values: dict[str, Value | None]  # column name -> value (normalized)
     differs: bool
 
 
-def compare(sources: Mapping[str, ParameterSource], variables: Iterable[Variable], *,
-            group: str | None = None, only_differences: bool = False,
-            between: tuple[str, str] | None = None) -> list[CompareRow]:
+def compare(
+    sources: Mapping[str, ParameterSource],
+    variables: Iterable[Variable],
+    *,
+    group: str | None = None,
+    only_differences: bool = False,
+    between: tuple[str, str] | None = None,
+) -> list[CompareRow]:
     """One row per variable (in the given order), optionally only one UI group and only rows that differ.
 
     ``between=(actual, reference)`` compares only those two columns, and a row whose reference column has no value
@@ -65,8 +70,10 @@ def compare(sources: Mapping[str, ParameterSource], variables: Iterable[Variable
     for variable in variables:
         if group is not None and variable.group.casefold() != group.casefold():
             continue
-        values = {name: normalize(variable, source.read(variable.index, variable.subindex))
-                  for name, source in sources.items()}
+        values = {
+            name: normalize(variable, source.read(variable.index, variable.subindex))
+            for name, source in sources.items()
+        }
         differs = _differs(values, between)
         if differs or not only_differences:
             rows.append(CompareRow(variable, values, differs))

@@ -11,10 +11,10 @@ from __future__ import annotations
 import re
 
 from servostudio.od import ObjectKind, Variable
-from servostudio.od.values import float_bit_pattern
+from servostudio.od.eds_values import float_bit_pattern
 from servostudio.services.projects.axisvalues import AxisValues
 from servostudio.services.projects.model import Axis, Project
-from servostudio.services.projects.values import Value
+from servostudio.services.projects.parameter_values import Value
 
 _SECTION = re.compile(r"^\s*\[([^\]]+)\]\s*$")
 _OBJECT_SECTION = re.compile(r"^([0-9A-Fa-f]{4})(?:sub([0-9A-Fa-f]{1,2}))?$")

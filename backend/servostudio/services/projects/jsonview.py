@@ -7,11 +7,11 @@ import dataclasses
 from servostudio.services.projects.compare import CompareRow
 from servostudio.services.projects.errors import ProjectError
 from servostudio.services.projects.motors import Motor
+from servostudio.services.projects.parameter_values import display
 from servostudio.services.projects.parameters import ParameterRow
 from servostudio.services.projects.service import AxisChoice
 from servostudio.services.projects.store import ProjectStore, Snapshot
 from servostudio.services.projects.templates import ApplicationTemplate
-from servostudio.services.projects.values import display
 
 
 def project_view(snapshot: Snapshot) -> dict:
@@ -34,49 +34,74 @@ def summaries(store: ProjectStore) -> list[dict]:
         except ProjectError as error:
             result.append({"name": name, "description": "", "axis_count": 0, "revision": "", "error": str(error)})
             continue
-        result.append({"name": name, "description": snapshot.project.description,
-                       "axis_count": len(snapshot.project.axes), "revision": snapshot.revision, "error": None})
+        result.append(
+            {
+                "name": name,
+                "description": snapshot.project.description,
+                "axis_count": len(snapshot.project.axes),
+                "revision": snapshot.revision,
+                "error": None,
+            }
+        )
     return result
 
 
 def parameter_view(row: ParameterRow) -> dict:
     variable = row.variable
     return {
-        "index": variable.index, "subindex": variable.subindex, "name": variable.label, "group": variable.group,
-        "data_type": variable.data_type.name, "access": variable.access.value,
-        "save_type": variable.save_type.value, "unit": variable.unit,
-        "value": display(variable, row.value), "default": display(variable, row.default),
-        "differs_from_default": row.differs_from_default, "file": row.file,
-        "editable": row.editable_reason is None, "not_editable_reason": row.editable_reason,
+        "index": variable.index,
+        "subindex": variable.subindex,
+        "name": variable.label,
+        "group": variable.group,
+        "data_type": variable.data_type.name,
+        "access": variable.access.value,
+        "save_type": variable.save_type.value,
+        "unit": variable.unit,
+        "value": display(variable, row.value),
+        "default": display(variable, row.default),
+        "differs_from_default": row.differs_from_default,
+        "file": row.file,
+        "editable": row.editable_reason is None,
+        "not_editable_reason": row.editable_reason,
     }
 
 
 def compare_view(row: CompareRow) -> dict:
     variable = row.variable
     return {
-        "index": variable.index, "subindex": variable.subindex, "name": variable.label, "group": variable.group,
-        "unit": variable.unit, "values": {name: display(variable, value) for name, value in row.values.items()},
+        "index": variable.index,
+        "subindex": variable.subindex,
+        "name": variable.label,
+        "group": variable.group,
+        "unit": variable.unit,
+        "values": {name: display(variable, value) for name, value in row.values.items()},
         "differs": row.differs,
     }
 
 
 def choice_view(choice: AxisChoice) -> dict:
-    return {"changed": [parameter_view(row) for row in choice.change.rows], "notes": choice.notes,
-            "project": project_view(choice.snapshot)}
+    return {
+        "changed": [parameter_view(row) for row in choice.change.rows],
+        "notes": choice.notes,
+        "project": project_view(choice.snapshot),
+    }
 
 
 def template_view(template: ApplicationTemplate) -> dict:
     return {
-        "key": template.key, "title": template.title, "description": template.description,
-        "settings": [{"index": s.index, "subindex": s.sub, "value": s.value, "why": s.why}
-                     for s in template.settings],
+        "key": template.key,
+        "title": template.title,
+        "description": template.description,
+        "settings": [{"index": s.index, "subindex": s.sub, "value": s.value, "why": s.why} for s in template.settings],
         "groups": list(template.groups) if template.groups is not None else None,
     }
 
 
 def motor_view(motor: Motor) -> dict:
     return {
-        "reference": motor.reference, "description": motor.description, "source": motor.source,
+        "reference": motor.reference,
+        "description": motor.description,
+        "source": motor.source,
         "motor_data": dict(motor.motor_data),
         "objects": {f"0x{index:04X},{sub}": value for (index, sub), value in motor.objects.items()},
         "builtin": motor.builtin,

@@ -2,5 +2,5 @@
 
 PROJECT_FILE = "project.toml"
 SEQUENCE = "SEQUENCE.TXT"
-USER_MOTORS_DIR = ".motors"          # user motor catalog inside the project store (names never start with '.')
-TEMP_PREFIX = "."                    # temporary files and directories start with a dot and are never listed
+USER_MOTORS_DIR = ".motors"  # user motor catalog inside the project store (names never start with '.')
+TEMP_PREFIX = "."  # temporary files and directories start with a dot and are never listed

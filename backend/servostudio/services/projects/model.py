@@ -35,8 +35,8 @@ class Axis:
     node_id: int
     bus: str
     description: str = ""
-    motor: str = ""          # reference of the motor chosen from the catalog ("" = none)
-    application: str = ""    # Device Config template key ("" = none chosen)
+    motor: str = ""  # reference of the motor chosen from the catalog ("" = none)
+    application: str = ""  # Device Config template key ("" = none chosen)
 
 
 @dataclass(frozen=True)
@@ -63,10 +63,16 @@ def to_text(project: Project) -> str:
     for bus in project.buses:
         document[("bus", bus.name)] = _table({"interface": bus.interface, "bitrate": bus.bitrate})
     for axis in project.axes:
-        document[("axis", axis.name)] = _table({
-            "device": axis.device, "node_id": axis.node_id, "bus": axis.bus, "description": axis.description,
-            "motor": axis.motor, "application": axis.application,
-        })
+        document[("axis", axis.name)] = _table(
+            {
+                "device": axis.device,
+                "node_id": axis.node_id,
+                "bus": axis.bus,
+                "description": axis.description,
+                "motor": axis.motor,
+                "application": axis.application,
+            }
+        )
     return tomlsubset.dump(document, HEADER_COMMENT)
 
 
@@ -91,14 +97,23 @@ def from_text(text: str, source: Path | str, name: str) -> Project:
             buses.append(Bus(path[1], reader.get(table, "interface", str), reader.get(table, "bitrate", int, None)))
         elif len(path) == 2 and path[0] == "axis":
             reader.only(table, {"device", "node_id", "bus", "description", "motor", "application"})
-            axes.append(Axis(
-                name=path[1], device=reader.get(table, "device", str), node_id=reader.get(table, "node_id", int),
-                bus=reader.get(table, "bus", str), description=reader.get(table, "description", str, ""),
-                motor=reader.get(table, "motor", str, ""), application=reader.get(table, "application", str, ""),
-            ))
+            axes.append(
+                Axis(
+                    name=path[1],
+                    device=reader.get(table, "device", str),
+                    node_id=reader.get(table, "node_id", int),
+                    bus=reader.get(table, "bus", str),
+                    description=reader.get(table, "description", str, ""),
+                    motor=reader.get(table, "motor", str, ""),
+                    application=reader.get(table, "application", str, ""),
+                )
+            )
         else:
-            raise FileFormatError(source, table.line, f"unknown table [{tomlsubset.format_path(path)}]; expected "
-                                  "[project], [bus.NAME] or [axis.NAME]")
+            raise FileFormatError(
+                source,
+                table.line,
+                f"unknown table [{tomlsubset.format_path(path)}]; expected [project], [bus.NAME] or [axis.NAME]",
+            )
     return Project(name, reader.get(head, "description", str, ""), tuple(buses), tuple(axes))
 
 

@@ -34,10 +34,31 @@ BUILTIN_MOTORS_DIR = Path(os.environ.get("SERVOSTUDIO_MOTORS_DIR") or Path(__fil
 #: The motor data of a catalog entry, in the order of the sub-entries 1..25 of the XtrapulsPac's 0x6410 Motor Data
 #: (manual L4894-5268), which is what Gem Drive Studio's catalog fills in.
 MOTOR_DATA_FIELDS: tuple[str, ...] = (
-    "manufacturer", "model", "code", "catalog_date", "modification_date", "motor_type", "max_speed", "rated_speed",
-    "stall_current", "peak_current", "torque_constant", "inertia", "inductance", "pole_pairs", "phase_order",
-    "sensor_offset", "temperature_probe", "temperature_warning", "temperature_error", "pole_pitch",
-    "magnetization_current", "rotor_time_constant", "base_speed", "leakage_factor", "saturation_model",
+    "manufacturer",
+    "model",
+    "code",
+    "catalog_date",
+    "modification_date",
+    "motor_type",
+    "max_speed",
+    "rated_speed",
+    "stall_current",
+    "peak_current",
+    "torque_constant",
+    "inertia",
+    "inductance",
+    "pole_pairs",
+    "phase_order",
+    "sensor_offset",
+    "temperature_probe",
+    "temperature_warning",
+    "temperature_error",
+    "pole_pitch",
+    "magnetization_current",
+    "rotor_time_constant",
+    "base_speed",
+    "leakage_factor",
+    "saturation_model",
 )
 _TEXT_FIELDS = {"manufacturer", "model", "code"}
 _ADDRESS = re.compile(r"0x([0-9A-Fa-f]{4}),([0-9]{1,3})")
@@ -56,14 +77,25 @@ class Motor:
 
 def motor_to_text(motor: Motor) -> str:
     document: tomlsubset.Document = {
-        ("motor",): tomlsubset.Table(values={key: value for key, value in (
-            ("reference", motor.reference), ("description", motor.description), ("source", motor.source)) if value}),
-        ("motor_data",): tomlsubset.Table(values={name: motor.motor_data[name] for name in MOTOR_DATA_FIELDS
-                                                  if name in motor.motor_data}),
+        ("motor",): tomlsubset.Table(
+            values={
+                key: value
+                for key, value in (
+                    ("reference", motor.reference),
+                    ("description", motor.description),
+                    ("source", motor.source),
+                )
+                if value
+            }
+        ),
+        ("motor_data",): tomlsubset.Table(
+            values={name: motor.motor_data[name] for name in MOTOR_DATA_FIELDS if name in motor.motor_data}
+        ),
     }
     if motor.objects:
-        document[("objects",)] = tomlsubset.Table(values={
-            f"0x{index:04X},{sub}": value for (index, sub), value in sorted(motor.objects.items())})
+        document[("objects",)] = tomlsubset.Table(
+            values={f"0x{index:04X},{sub}": value for (index, sub), value in sorted(motor.objects.items())}
+        )
     return tomlsubset.dump(document, HEADER)
 
 
@@ -74,12 +106,16 @@ def motor_from_text(text: str, source: Path | str, builtin: bool = False) -> Mot
         raise FileFormatError(source, 1, "the [motor] table is missing")
     for path, table in document.items():
         if path not in (("motor",), ("motor_data",), ("objects",)):
-            raise FileFormatError(source, table.line, f"unknown table [{tomlsubset.format_path(path)}]; "
-                                  "expected [motor], [motor_data], [objects]")
+            raise FileFormatError(
+                source,
+                table.line,
+                f"unknown table [{tomlsubset.format_path(path)}]; expected [motor], [motor_data], [objects]",
+            )
     for key, line in head.lines.items():
         if key not in ("reference", "description", "source") or not isinstance(head.values[key], str):
-            raise FileFormatError(source, line, f"[motor] key '{key}' must be one of reference, description, "
-                                  "source, as a quoted string")
+            raise FileFormatError(
+                source, line, f"[motor] key '{key}' must be one of reference, description, source, as a quoted string"
+            )
     if "reference" not in head.values:
         raise FileFormatError(source, head.line, "[motor] needs a reference")
     data = document.get(("motor_data",), tomlsubset.Table())
@@ -90,12 +126,21 @@ def motor_from_text(text: str, source: Path | str, builtin: bool = False) -> Mot
     for key, value in other.values.items():
         match = _ADDRESS.fullmatch(key)
         if not match or isinstance(value, bool):
-            raise FileFormatError(source, other.lines[key], f"[objects] key {key!r} must look like \"0x3324,1\" and "
-                                  "its value be a number or a string")
+            raise FileFormatError(
+                source,
+                other.lines[key],
+                f'[objects] key {key!r} must look like "0x3324,1" and its value be a number or a string',
+            )
         objects[(int(match[1], 16), int(match[2]))] = value
     motor_data = {name: data.values[name] for name in MOTOR_DATA_FIELDS if name in data.values}
-    return Motor(head.values["reference"], head.values.get("description", ""), head.values.get("source", ""),
-                 motor_data, objects, builtin)
+    return Motor(
+        head.values["reference"],
+        head.values.get("description", ""),
+        head.values.get("source", ""),
+        motor_data,
+        objects,
+        builtin,
+    )
 
 
 def _check_data_field(key: str, value: object, source: Path | str, line: int) -> None:
@@ -119,8 +164,9 @@ class MotorCatalog:
             for path in _motor_files(directory):
                 motor = motor_from_text(path.read_text(encoding="utf-8"), path, builtin)
                 if motor.reference != path.stem:
-                    raise FileFormatError(path, 1, f"reference '{motor.reference}' must equal the file name "
-                                          f"'{path.stem}'")
+                    raise FileFormatError(
+                        path, 1, f"reference '{motor.reference}' must equal the file name '{path.stem}'"
+                    )
                 found.setdefault(motor.reference.casefold(), motor)
         return sorted(found.values(), key=lambda motor: motor.reference.casefold())
 
@@ -131,7 +177,7 @@ class MotorCatalog:
         raise ProjectNotFound(f"no motor '{reference}' in the catalog")
 
     def add(self, motor: Motor, replace_existing: bool = False) -> Motor:
-        """"Add new motor": store a user entry; a built-in reference is never overwritten."""
+        """ "Add new motor": store a user entry; a built-in reference is never overwritten."""
         if self.user_dir is None:
             raise ValidationError("this motor catalog has no user directory")
         check_name(motor.reference, "motor")
@@ -139,8 +185,10 @@ class MotorCatalog:
             _check_data_field(key, value, f"motor {motor.reference}", 0)
         for existing in self.motors():
             if same_name(existing.reference, motor.reference) and (existing.builtin or not replace_existing):
-                raise ProjectExists(f"motor '{existing.reference}' is already in the catalog"
-                                    + (" (built-in)" if existing.builtin else ""))
+                raise ProjectExists(
+                    f"motor '{existing.reference}' is already in the catalog"
+                    + (" (built-in)" if existing.builtin else "")
+                )
         self.user_dir.mkdir(parents=True, exist_ok=True)
         text = motor_to_text(motor)
         motor_from_text(text, f"motor {motor.reference}")

@@ -33,8 +33,8 @@ MAX_CURRENT_PER_MILLE = 32767
 class MotorDataLayout:
     """Where a device keeps the catalog's motor data and what it derives from it."""
 
-    subs: Mapping[str, Key]           # motor-file field -> object
-    copies: Mapping[str, Key]         # motor-file field -> object the drive copies the value into
+    subs: Mapping[str, Key]  # motor-file field -> object
+    copies: Mapping[str, Key]  # motor-file field -> object the drive copies the value into
     rated_current: Key
     max_current: Key
     drive_max_current: Key
@@ -44,10 +44,17 @@ class MotorDataLayout:
 XTRAPULSPAC_MOTOR_DATA = MotorDataLayout(
     subs={name: (0x6410, sub) for sub, name in enumerate(MOTOR_DATA_FIELDS, start=1)},
     copies={
-        "motor_type": (0x6402, 0), "max_speed": (0x6080, 0), "inductance": (0x340F, 0),
-        "pole_pairs": (0x3410, 1), "phase_order": (0x3410, 2), "sensor_offset": (0x3410, 3),
-        "magnetization_current": (0x3420, 1), "rotor_time_constant": (0x3420, 2), "base_speed": (0x3420, 3),
-        "leakage_factor": (0x3420, 4), "saturation_model": (0x3420, 5),
+        "motor_type": (0x6402, 0),
+        "max_speed": (0x6080, 0),
+        "inductance": (0x340F, 0),
+        "pole_pairs": (0x3410, 1),
+        "phase_order": (0x3410, 2),
+        "sensor_offset": (0x3410, 3),
+        "magnetization_current": (0x3420, 1),
+        "rotor_time_constant": (0x3420, 2),
+        "base_speed": (0x3420, 3),
+        "leakage_factor": (0x3420, 4),
+        "saturation_model": (0x3420, 5),
     },
     rated_current=(0x6075, 0),
     max_current=(0x6073, 0),
@@ -59,8 +66,8 @@ LAYOUTS: dict[str, MotorDataLayout] = {"xtrapulspac": XTRAPULSPAC_MOTOR_DATA}
 
 @dataclass(frozen=True)
 class MotorApplication:
-    changed: list[Variable]       # every object the selection set, in order
-    notes: list[str]              # consequences not reproduced, or reproduced with missing inputs
+    changed: list[Variable]  # every object the selection set, in order
+    notes: list[str]  # consequences not reproduced, or reproduced with missing inputs
 
 
 def current_limits(stall: int, peak: int, drive_max: int, drive_rated: int) -> tuple[int, int]:
@@ -78,8 +85,10 @@ def apply_motor(values: AxisValues, motor: Motor) -> MotorApplication:
     device = values.dictionary.device
     layout = LAYOUTS.get(device)
     if layout is None:
-        raise ParameterRefused(f"device '{device}' does not take catalog motors (the catalog uses the XtrapulsPac "
-                               "0x6410 motor data layout)")
+        raise ParameterRefused(
+            f"device '{device}' does not take catalog motors (the catalog uses the XtrapulsPac "
+            "0x6410 motor data layout)"
+        )
     changed: list[Variable] = []
     notes: list[str] = []
     for name, value in motor.motor_data.items():
@@ -95,8 +104,10 @@ def apply_motor(values: AxisValues, motor: Motor) -> MotorApplication:
 def _stage(values: AxisValues, key: Key, value: object, motor: Motor) -> Variable:
     variable = values.dictionary.get(*key)
     if variable is None:
-        raise ParameterRefused(f"motor '{motor.reference}' sets 0x{key[0]:04X},{key[1]}, which device "
-                               f"'{values.dictionary.device}' does not have")
+        raise ParameterRefused(
+            f"motor '{motor.reference}' sets 0x{key[0]:04X},{key[1]}, which device "
+            f"'{values.dictionary.device}' does not have"
+        )
     values.stage(variable, value)
     return variable
 
@@ -115,8 +126,9 @@ def _consequence(values: AxisValues, key: Key, value: object, changed: list[Vari
     changed.append(target)
 
 
-def _current_limits(values: AxisValues, layout: MotorDataLayout, motor: Motor, changed: list[Variable],
-                    notes: list[str]) -> None:
+def _current_limits(
+    values: AxisValues, layout: MotorDataLayout, motor: Motor, changed: list[Variable], notes: list[str]
+) -> None:
     stall = motor.motor_data.get("stall_current")
     peak = motor.motor_data.get("peak_current")
     if not isinstance(stall, int) and not isinstance(peak, int):
@@ -127,8 +139,10 @@ def _current_limits(values: AxisValues, layout: MotorDataLayout, motor: Motor, c
         current = values.value(variable) if variable is not None else None
         drive.append(current if isinstance(current, int) else 0)
     if 0 in drive:
-        notes.append("current limits derived from the motor data alone: the drive's current ratings 0x6510,1/2 are "
-                     "unknown offline and the drive caps the limits to them")
+        notes.append(
+            "current limits derived from the motor data alone: the drive's current ratings 0x6510,1/2 are "
+            "unknown offline and the drive caps the limits to them"
+        )
     rated, maximum = current_limits(stall or 0, peak or 0, *drive)
     if rated:
         _consequence(values, layout.rated_current, rated, changed, notes)

@@ -15,8 +15,8 @@ from servostudio.services.projects.axisvalues import AxisValues
 from servostudio.services.projects.compare import CompareRow, DefaultValues, ParameterSource, ProjectValues, compare
 from servostudio.services.projects.errors import ParameterRefused, ProjectNotFound
 from servostudio.services.projects.model import Axis
+from servostudio.services.projects.parameter_values import Value
 from servostudio.services.projects.store import ProjectEdit, ProjectStore
-from servostudio.services.projects.values import Value
 
 
 class DictionaryLibrary(Protocol):
@@ -31,7 +31,7 @@ class ParameterRow:
     variable: Variable
     value: Value | None
     default: Value | None
-    file: str | None            # the axis file that sets it; None = follows the default
+    file: str | None  # the axis file that sets it; None = follows the default
     editable_reason: str | None  # None = editable offline
 
     @property
@@ -56,8 +56,16 @@ class ParameterService:
         except LibraryError as error:
             raise ProjectNotFound(f"axis '{axis.name}': {error}") from None
 
-    def rows(self, project: str, axis: str, *, group: str | None = None, only_set: bool = False,
-             only_differences: bool = False, include_unsaved: bool = False) -> tuple[list[ParameterRow], str]:
+    def rows(
+        self,
+        project: str,
+        axis: str,
+        *,
+        group: str | None = None,
+        only_set: bool = False,
+        only_differences: bool = False,
+        include_unsaved: bool = False,
+    ) -> tuple[list[ParameterRow], str]:
         """The parameters of an axis (objects saved in a drive file, or every object with ``include_unsaved``)."""
         with self.store.read(project) as view:
             values = self._load(view, axis)
@@ -78,8 +86,9 @@ class ParameterService:
             values = self._load(view, axis)
             return parameter_row(values, values.resolve(address)), view.revision
 
-    def set(self, project: str, axis: str, changes: Mapping[str, object],
-            expected_revision: str | None = None) -> ParameterChange:
+    def set(
+        self, project: str, axis: str, changes: Mapping[str, object], expected_revision: str | None = None
+    ) -> ParameterChange:
         """Set several objects (address -> value) at once; any refusal leaves every file unchanged."""
         if not changes:
             raise ParameterRefused("no parameter given")
@@ -91,8 +100,9 @@ class ParameterService:
             values.commit(edit, axis)
         return ParameterChange([parameter_row(values, variable) for variable in touched], edit.revision)
 
-    def unset(self, project: str, axis: str, addresses: Iterable[str],
-              expected_revision: str | None = None) -> ParameterChange:
+    def unset(
+        self, project: str, axis: str, addresses: Iterable[str], expected_revision: str | None = None
+    ) -> ParameterChange:
         """Remove the project's values of these objects: they follow the dictionary default again."""
         with self.store.edit(project, expected_revision) as edit:
             values = self._load(edit, axis)
@@ -102,8 +112,15 @@ class ParameterService:
             values.commit(edit, axis)
         return ParameterChange([parameter_row(values, variable) for variable in touched], edit.revision)
 
-    def compare(self, project: str, axis: str, *, group: str | None = None, only_differences: bool = False,
-                drive: ParameterSource | None = None) -> tuple[list[CompareRow], str]:
+    def compare(
+        self,
+        project: str,
+        axis: str,
+        *,
+        group: str | None = None,
+        only_differences: bool = False,
+        drive: ParameterSource | None = None,
+    ) -> tuple[list[CompareRow], str]:
         """Columns project / default for every saved object of the axis; with a ``drive``, columns drive / project /
         default for the objects drive and project exchange (:meth:`AxisValues.transferable`), and a row differs
         when the drive's value is not the project's."""
@@ -118,8 +135,13 @@ class ParameterService:
                 chosen = [v for v in values.dictionary.variables() if v.save_type is not SaveType.NONE]
             else:
                 chosen = values.transferable()
-            rows = compare(sources, chosen, group=group, only_differences=only_differences,
-                           between=("drive", "project") if drive is not None else None)
+            rows = compare(
+                sources,
+                chosen,
+                group=group,
+                only_differences=only_differences,
+                between=("drive", "project") if drive is not None else None,
+            )
             return rows, view.revision
 
     def transferable(self, project: str, axis: str, group: str | None = None) -> list[Variable]:
@@ -138,5 +160,10 @@ class ParameterService:
 
 
 def parameter_row(values: AxisValues, variable: Variable) -> ParameterRow:
-    return ParameterRow(variable, values.value(variable), values.default(variable), values.file_of(variable),
-                        values.editable_reason(variable))
+    return ParameterRow(
+        variable,
+        values.value(variable),
+        values.default(variable),
+        values.file_of(variable),
+        values.editable_reason(variable),
+    )

@@ -36,8 +36,7 @@ class ProjectService:
         self.parameters = ParameterService(self.store, library)
         self.motors = MotorCatalog(motors_dir, Path(root) / layout.USER_MOTORS_DIR)
 
-    def select_motor(self, project: str, axis: str, reference: str,
-                     expected_revision: str | None = None) -> AxisChoice:
+    def select_motor(self, project: str, axis: str, reference: str, expected_revision: str | None = None) -> AxisChoice:
         """Record the catalog motor for the axis and set its values and their consequences (all or nothing)."""
         motor = self.motors.get(reference)
         with self.store.edit(project, expected_revision) as edit:
@@ -77,8 +76,7 @@ class ProjectService:
     def archive(self, project: str, destination: Path) -> Path:
         return archive_project(self.store, project, destination)
 
-    def unarchive(self, source: Path, new_name: str | None = None,
-                  limits: ArchiveLimits = DEFAULT_LIMITS) -> Snapshot:
+    def unarchive(self, source: Path, new_name: str | None = None, limits: ArchiveLimits = DEFAULT_LIMITS) -> Snapshot:
         return unarchive_project(self.store, source, new_name, limits, verify=self.check_axis_files)
 
     def check_axis_files(self, directory: Path, project: Project) -> None:

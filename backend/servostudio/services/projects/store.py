@@ -90,8 +90,11 @@ class ProjectStore:
         if not self.root.is_dir():
             return []
         return sorted(
-            (entry.name for entry in self.root.iterdir()
-             if is_valid_name(entry.name) and (entry / layout.PROJECT_FILE).is_file()),
+            (
+                entry.name
+                for entry in self.root.iterdir()
+                if is_valid_name(entry.name) and (entry / layout.PROJECT_FILE).is_file()
+            ),
             key=str.casefold,
         )
 
@@ -110,8 +113,14 @@ class ProjectStore:
                 os.rename(staging, self.root / name)
             return Snapshot(project, revision_of(self.root / name))
 
-    def update(self, name: str, expected_revision: str | None = None, *, description: str | None = None,
-               buses: tuple[Bus, ...] | None = None) -> Snapshot:
+    def update(
+        self,
+        name: str,
+        expected_revision: str | None = None,
+        *,
+        description: str | None = None,
+        buses: tuple[Bus, ...] | None = None,
+    ) -> Snapshot:
         with self.edit(name, expected_revision) as edit:
             project = edit.project
             if description is not None:
@@ -156,19 +165,21 @@ class ProjectStore:
     def add_axis(self, name: str, axis: Axis, expected_revision: str | None = None) -> Snapshot:
         return self.add_axes(name, (axis,), expected_revision)
 
-    def add_axes(self, name: str, axes: tuple[Axis, ...], expected_revision: str | None = None,
-                 buses: tuple[Bus, ...] = ()) -> Snapshot:
+    def add_axes(
+        self, name: str, axes: tuple[Axis, ...], expected_revision: str | None = None, buses: tuple[Bus, ...] = ()
+    ) -> Snapshot:
         """Add buses and axes in one change (a scan adds its findings together): all are validated first; an axis
         directory is built in a staging directory and renamed into place before the project file names it."""
         with self.edit(name, expected_revision) as edit:
-            project = replace(edit.project, buses=(*edit.project.buses, *buses),
-                              axes=(*edit.project.axes, *axes))
+            project = replace(edit.project, buses=(*edit.project.buses, *buses), axes=(*edit.project.axes, *axes))
             self._validate(project)
             for axis in axes:
                 directory = edit.directory / axis.name
                 if directory.exists():
-                    raise ProjectExists(f"'{directory}' already exists but is not an axis of project '{name}';"
-                                        " move it away or choose another axis name")
+                    raise ProjectExists(
+                        f"'{directory}' already exists but is not an axis of project '{name}';"
+                        " move it away or choose another axis name"
+                    )
             for axis in axes:
                 with self.staging(edit.directory) as staging:
                     for file_name in axis_files(axis.device):
@@ -177,8 +188,9 @@ class ProjectStore:
             edit.save(project)
         return Snapshot(edit.project, edit.revision)
 
-    def edit_axis(self, project: str, axis_name: str, expected_revision: str | None = None,
-                  **changes: object) -> Snapshot:
+    def edit_axis(
+        self, project: str, axis_name: str, expected_revision: str | None = None, **changes: object
+    ) -> Snapshot:
         """Change fields of an axis (``name``, ``device``, ``node_id``, ``bus``, ``description``); renaming an axis
         renames its directory."""
         unknown = set(changes) - {"name", "device", "node_id", "bus", "description"}
@@ -269,8 +281,9 @@ class ProjectStore:
         finally:
             shutil.rmtree(staging, ignore_errors=True)
 
-    def adopt(self, directory: Path, name: str, rename: bool,
-              verify: Callable[[Path, Project], None] | None = None) -> None:
+    def adopt(
+        self, directory: Path, name: str, rename: bool, verify: Callable[[Path, Project], None] | None = None
+    ) -> None:
         """Move a complete project directory (built in :meth:`staging`) into the store as ``name``.
 
         The project file is validated (and ``verify`` may check the axis files), and rewritten only when the
@@ -306,8 +319,10 @@ def _switch_device_files(directory: Path, axis: Axis, device: str) -> None:
     directory.mkdir(exist_ok=True)
     files = [path for path in directory.iterdir() if path.is_file() and not path.name.startswith(layout.TEMP_PREFIX)]
     if any(path.stat().st_size for path in files):
-        raise ValidationError(f"axis '{axis.name}' holds values for device '{axis.device}' in {directory}; "
-                              "add a new axis for the other device instead")
+        raise ValidationError(
+            f"axis '{axis.name}' holds values for device '{axis.device}' in {directory}; "
+            "add a new axis for the other device instead"
+        )
     wanted = axis_files(device)
     for path in files:
         if path.name not in wanted:

@@ -31,11 +31,20 @@ class ApplicationTemplate:
     description: str
     devices: tuple[str, ...]
     settings: tuple[Setting, ...]
-    groups: tuple[str, ...] | None      # UI groups to show; None = all (Expert mode)
+    groups: tuple[str, ...] | None  # UI groups to show; None = all (Expert mode)
 
 
-_COMMON_GROUPS = ("Communication", "General", "Device Control", "Motor", "Sensors", "Servo Loops", "Auto-tuning",
-                  "Error Control", "Application Features")
+_COMMON_GROUPS = (
+    "Communication",
+    "General",
+    "Device Control",
+    "Motor",
+    "Sensors",
+    "Servo Loops",
+    "Auto-tuning",
+    "Error Control",
+    "Application Features",
+)
 
 TEMPLATES: tuple[ApplicationTemplate, ...] = (
     ApplicationTemplate(
@@ -64,8 +73,12 @@ TEMPLATES: tuple[ApplicationTemplate, ...] = (
             Setting(0x3050, 2, 0x36010101, "IN2 -> SEQ SEL 2 = bit 1 of 0x3601,1 (project choice)"),
             Setting(0x3050, 3, 0x36010102, "IN3 -> SEQ SEL 3 = bit 2 of 0x3601,1 (project choice)"),
             Setting(0x3050, 4, 0x36010103, "IN4 -> SEQ SEL 4 = bit 3 of 0x3601,1 (project choice)"),
-            Setting(0x3050, 5, 0x60400004, "IN5 -> SEQ START = control word bit 4 (rising edge starts, L9697-9702;"
-                                           " input choice is the project's)"),
+            Setting(
+                0x3050,
+                5,
+                0x60400004,
+                "IN5 -> SEQ START = control word bit 4 (rising edge starts, L9697-9702; input choice is the project's)",
+            ),
             Setting(0x3054, 1, 0x6041000A, "OUT1 <- IN POS = status word bit 10 target reached (project choice)"),
         ),
         groups=(*_COMMON_GROUPS, "Factor", "Position Control", "Profile Position Mode", "Homing Mode", "Sequence Mode"),
@@ -77,8 +90,13 @@ TEMPLATES: tuple[ApplicationTemplate, ...] = (
         devices=("xtrapulspac",),
         settings=(
             Setting(0x6060, 0, -2, "mode Stepper Emulation (L8308-8359, L11282-11514)"),
-            Setting(0x3681, 3, 0x013A, "PULSE/DIR on the Hall lines, both polarities inverted, counting enabled "
-                                       "(the manual's configuration example, L11496-11514)"),
+            Setting(
+                0x3681,
+                3,
+                0x013A,
+                "PULSE/DIR on the Hall lines, both polarities inverted, counting enabled "
+                "(the manual's configuration example, L11496-11514)",
+            ),
             Setting(0x3681, 4, 10, "PULSE_CNT timeout 10 ms (same example)"),
             Setting(0x3054, 3, 0x36810201, "OUT3 <- PULSE_CNT (same example)"),
         ),

@@ -57,8 +57,12 @@ def parse(text: str, source: Path | str = "<text>") -> Document:
         line = raw.removesuffix("\r").strip(" \t")
         control = _CONTROL.search(line)
         if control:
-            raise FileFormatError(source, number, f"control character U+{ord(control.group()):04X} is not allowed "
-                                  "(write it as an escape inside a quoted string)")
+            raise FileFormatError(
+                source,
+                number,
+                f"control character U+{ord(control.group()):04X} is not allowed "
+                "(write it as an escape inside a quoted string)",
+            )
         if not line or line.startswith("#"):
             continue
         cursor = _Cursor(line, source, number)
@@ -80,7 +84,7 @@ def parse(text: str, source: Path | str = "<text>") -> Document:
         cursor.expect_end()
         if key in current.values:
             cursor.fail(f"key {key!r} is set twice in this table (first at line {current.lines[key]})")
-        if any(path[:len(current_path) + 1] == (*current_path, key) for path in document):
+        if any(path[: len(current_path) + 1] == (*current_path, key) for path in document):
             cursor.fail(f"key {key!r} is also the name of a table")
         current.values[key] = value
         current.lines[key] = number
@@ -157,7 +161,7 @@ class _Cursor:
     def expect_end(self) -> None:
         self.skip_spaces()
         if self.peek() and self.peek() != "#":
-            self.fail(f"unexpected text {self.text[self.pos:]!r} at column {self.pos + 1}")
+            self.fail(f"unexpected text {self.text[self.pos :]!r} at column {self.pos + 1}")
 
 
 def _check_no_key_clash(document: Document, path: TablePath, cursor: _Cursor) -> None:
@@ -165,8 +169,9 @@ def _check_no_key_clash(document: Document, path: TablePath, cursor: _Cursor) ->
     for depth in range(1, len(path)):
         parent = document.get(path[:depth])
         if parent is not None and path[depth] in parent.values:
-            cursor.fail(f"table [{format_path(path)}] clashes with key {path[depth]!r} "
-                        f"of [{format_path(path[:depth])}]")
+            cursor.fail(
+                f"table [{format_path(path)}] clashes with key {path[depth]!r} of [{format_path(path[:depth])}]"
+            )
 
 
 def _parse_header(cursor: _Cursor) -> TablePath:
@@ -197,7 +202,7 @@ def _parse_key(cursor: _Cursor) -> str:
 def _parse_value(cursor: _Cursor) -> Value:
     if cursor.peek() == '"':
         return _parse_string(cursor)
-    token = re.match(r"[^\s#]+", cursor.text[cursor.pos:])
+    token = re.match(r"[^\s#]+", cursor.text[cursor.pos :])
     if not token:
         cursor.fail("a value is missing after '='")
     word = token.group()
@@ -235,7 +240,7 @@ def _parse_escape(cursor: _Cursor) -> str:
         return _ESCAPES[code]
     if code in ("u", "U"):
         width = 4 if code == "u" else 8
-        digits = cursor.text[cursor.pos:cursor.pos + width]
+        digits = cursor.text[cursor.pos : cursor.pos + width]
         if len(digits) != width or not re.fullmatch(r"[0-9A-Fa-f]+", digits):
             cursor.fail(f"\\{code} needs {width} hex digits")
         cursor.pos += width

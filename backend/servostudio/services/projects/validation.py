@@ -5,10 +5,10 @@ from __future__ import annotations
 from collections.abc import Collection
 
 from servostudio.drive.profiles import profile_for
-from servostudio.transport.spec import BusSpecError, parse_bus_spec
 from servostudio.services.projects.errors import ValidationError
 from servostudio.services.projects.model import Axis, Project
 from servostudio.services.projects.names import check_name, same_name
+from servostudio.transport.spec import BusSpecError, parse_bus_spec
 
 
 def validate_project(project: Project, known_devices: Collection[str]) -> None:
@@ -41,7 +41,8 @@ def _check_axis(axis: Axis, project: Project, known_devices: Collection[str]) ->
     check_name(axis.name, "axis")
     if axis.device not in known_devices:
         raise ValidationError(
-            f"axis '{axis.name}': unknown device '{axis.device}' (known: {', '.join(sorted(known_devices))})")
+            f"axis '{axis.name}': unknown device '{axis.device}' (known: {', '.join(sorted(known_devices))})"
+        )
     if project.bus(axis.bus) is None:
         buses = ", ".join(bus.name for bus in project.buses) or "none defined"
         raise ValidationError(f"axis '{axis.name}': unknown bus '{axis.bus}' (buses: {buses})")
@@ -49,7 +50,8 @@ def _check_axis(axis: Axis, project: Project, known_devices: Collection[str]) ->
     if axis.node_id not in rules.node_ids:
         raise ValidationError(
             f"axis '{axis.name}': node ID {axis.node_id} is out of range "
-            f"{rules.node_ids.start}-{rules.node_ids.stop - 1} ({rules.reason})")
+            f"{rules.node_ids.start}-{rules.node_ids.stop - 1} ({rules.reason})"
+        )
 
 
 def _check_bus_addresses(bus: str, axes: list[Axis]) -> None:
@@ -57,8 +59,10 @@ def _check_bus_addresses(bus: str, axes: list[Axis]) -> None:
     owner: dict[int, str] = {}
     for axis in axes:
         if axis.node_id in owner:
-            raise ValidationError(f"axis '{axis.name}': node ID {axis.node_id} on bus '{bus}' is already used by "
-                                  f"axis '{owner[axis.node_id]}'")
+            raise ValidationError(
+                f"axis '{axis.name}': node ID {axis.node_id} on bus '{bus}' is already used by "
+                f"axis '{owner[axis.node_id]}'"
+            )
         owner[axis.node_id] = axis.name
     for axis in axes:
         offset = profile_for(axis.device).addressing.redirect_offset
@@ -66,4 +70,5 @@ def _check_bus_addresses(bus: str, axes: list[Axis]) -> None:
             raise ValidationError(
                 f"axis '{owner[axis.node_id + offset]}': node ID {axis.node_id + offset} on bus '{bus}' is reserved by "
                 f"axis '{axis.name}' ({axis.device} node {axis.node_id} serves redirected SDO as node "
-                f"{axis.node_id + offset})")
+                f"{axis.node_id + offset})"
+            )

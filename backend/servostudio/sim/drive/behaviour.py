@@ -16,6 +16,7 @@ from typing import Any, Protocol
 from servostudio.sim.clock import CONTROL_PERIOD
 from servostudio.sim.drive import errors, gains
 from servostudio.sim.drive.commissioning import commissioned_values, current_limits
+from servostudio.sim.drive.device_map import MODE_HM, MODE_IP, MODE_PP, MODE_PT, MODE_PV, XTRAPULSPAC, DeviceProfile
 from servostudio.sim.drive.errors import DriveError
 from servostudio.sim.drive.loops import (
     MODE_OFF,
@@ -38,8 +39,8 @@ from servostudio.sim.drive.modes import (
 )
 from servostudio.sim.drive.physics import OVERCURRENT_FACTOR, TWO_PI, AxisPhysics
 from servostudio.sim.drive.procedures import ABORTED, FAILED
-from servostudio.sim.drive.profile import MODE_HM, MODE_IP, MODE_PP, MODE_PT, MODE_PV, XTRAPULSPAC, DeviceProfile
 from servostudio.sim.drive.protection import I2tProtection
+from servostudio.sim.drive.runner import ProcedureRunner
 from servostudio.sim.drive.statemachine import (
     STATE_BITS,
     STOP_CURRENT_LIMIT,
@@ -51,7 +52,6 @@ from servostudio.sim.drive.statemachine import (
     StopOptions,
     decode_command,
 )
-from servostudio.sim.drive.runner import ProcedureRunner
 from servostudio.sim.drive.units import RPM, UnitScaling
 from servostudio.sim.objects import ObjectStore
 from servostudio.sim.plant import FEEDBACK_ENCODER, PHASE_240, Plant
@@ -89,8 +89,9 @@ class Events(Protocol):
 class DriveBehaviour:
     """CiA 402 drive on the shared engine; device families differ by `DeviceProfile` and small overrides."""
 
-    def __init__(self, store: ObjectStore, plant: Plant, events: Events, commissioned: bool,
-                 profile: DeviceProfile = XTRAPULSPAC) -> None:
+    def __init__(
+        self, store: ObjectStore, plant: Plant, events: Events, commissioned: bool, profile: DeviceProfile = XTRAPULSPAC
+    ) -> None:
         self.store = store
         self.plant = plant
         self.events = events
@@ -198,8 +199,15 @@ class DriveBehaviour:
         store = self.store
         for index in sorted({address[0] for address in self._addresses.values()}):
             store.on_write(index, None, self._mark_dirty)
-        for name in ("motor_max_speed", "motor_stall_current", "motor_peak_current",
-                     "motor_inductance", "motor_pole_pairs", "motor_phase", "motor_offset"):
+        for name in (
+            "motor_max_speed",
+            "motor_stall_current",
+            "motor_peak_current",
+            "motor_inductance",
+            "motor_pole_pairs",
+            "motor_phase",
+            "motor_offset",
+        ):
             address = self._addresses.get(name)
             if address is not None:
                 store.on_write(address[0], address[1], self._motor_data_written(name))
@@ -208,8 +216,13 @@ class DriveBehaviour:
         for sub in range(21, 26):
             if (0x6410, sub) in store and (0x3420, sub - 20) in store:
                 store.on_write(0x6410, sub, lambda i, s, v: store.set(0x3420, s - 20, v))
-        for name in ("position_actual", "velocity_actual", "position_demand", "following_error_actual",
-                     "current_actual"):
+        for name in (
+            "position_actual",
+            "velocity_actual",
+            "position_demand",
+            "following_error_actual",
+            "current_actual",
+        ):
             address = self._addresses.get(name)
             if address is not None:
                 store.on_read(address[0], address[1], self._measurement_reader(name))
@@ -250,8 +263,9 @@ class DriveBehaviour:
         return hook
 
     def apply_current_limits(self, stall_ma: float, peak_ma: float) -> None:
-        rated, maximum = current_limits(stall_ma, peak_ma, float(self.live("drive_max_current", 0)),
-                                        float(self.live("drive_rated_current", 0)))
+        rated, maximum = current_limits(
+            stall_ma, peak_ma, float(self.live("drive_max_current", 0)), float(self.live("drive_rated_current", 0))
+        )
         if rated:
             self.write("rated_current", rated)
             self.write("max_current", maximum)
@@ -284,8 +298,9 @@ class DriveBehaviour:
 
     def apply_commissioning(self) -> None:
         """Write the plant's true motor data, phasing and gains over the dictionary defaults."""
-        values = commissioned_values(self.plant, float(self.p.get("drive_max_current", 0)),
-                                     float(self.p.get("drive_rated_current", 0)))
+        values = commissioned_values(
+            self.plant, float(self.p.get("drive_max_current", 0)), float(self.p.get("drive_rated_current", 0))
+        )
         values["motor_phase"] = values["control_phase"] = self.phase_value(self.plant.phase_sign)
         for name, value in values.items():
             address = self._addresses.get(name)
@@ -346,8 +361,9 @@ class DriveBehaviour:
         loops.torque_offset = float(read("torque_offset", 0)) / 1000.0 * self.rated_current
         loops.torque_offset_2 = float(read("torque_offset_2", 0)) / 1000.0 * self.rated_current
         supervision_dt = dt * SUPERVISION_PERIODS
-        self._current_filter_alpha = low_pass_alpha(max(float(read("current_monitor_filter", 1000)), 1.0),
-                                                    supervision_dt)
+        self._current_filter_alpha = low_pass_alpha(
+            max(float(read("current_monitor_filter", 1000)), 1.0), supervision_dt
+        )
         velocity_hz = float(read("velocity_monitor_filter", 0)) * 0.1
         self._velocity_filter_alpha = low_pass_alpha(velocity_hz, supervision_dt) if velocity_hz > 0 else 1.0
         options = self._stop_options
@@ -368,8 +384,9 @@ class DriveBehaviour:
 
     def read_units(self) -> UnitScaling:
         """Factor group 0x6093 (XtrapulsPac: numerator fixed at 4096 motor increments per revolution)."""
-        return UnitScaling.from_position_factor(int(self.p.get("position_factor_numerator", 4096)),
-                                                int(self.p.get("position_factor_denominator", 4096)))
+        return UnitScaling.from_position_factor(
+            int(self.p.get("position_factor_numerator", 4096)), int(self.p.get("position_factor_denominator", 4096))
+        )
 
     def read_currents(self) -> tuple[float, float, float]:
         """(drive max, motor rated, max allowed) in A: 0x6510,1 mA, 0x6075 mA, 0x6073 ‰ of 0x6075."""
@@ -709,8 +726,9 @@ class DriveBehaviour:
 
     def fault_reaction(self, error: DriveError) -> int:
         """Stop 2 / Stop 3 by the 0x3025,3..6 masks (allowed codes only), else Stop 0."""
-        return errors.stop_for(error.code, int(self.p.get(f"error_stop2_{error.word}", 0)),
-                               int(self.p.get(f"error_stop3_{error.word}", 0)))
+        return errors.stop_for(
+            error.code, int(self.p.get(f"error_stop2_{error.word}", 0)), int(self.p.get(f"error_stop3_{error.word}", 0))
+        )
 
     def send_emergency(self, error: DriveError) -> None:
         """EMCY: CiA 402 code, Infranor code in byte 3 (decisions.md §5)."""
@@ -823,8 +841,11 @@ class DriveBehaviour:
         loops = self.loops
         physics = self.physics
         units = self.units
-        self.write("velocity_demand", units.speed_to_user(loops.speed_demand if loops.mode != MODE_POSITION
-                                                    else loops.velocity_ff), integer=True)
+        self.write(
+            "velocity_demand",
+            units.speed_to_user(loops.speed_demand if loops.mode != MODE_POSITION else loops.velocity_ff),
+            integer=True,
+        )
         self.write("velocity_rpm", loops.speed / RPM, integer=True)
         self.write("torque_demand", _clamp_i16(1000.0 * loops.current_demand / self.rated_current))
         self.write("torque_actual", _clamp_i16(1000.0 * loops.i_q / self.rated_current))
@@ -834,8 +855,7 @@ class DriveBehaviour:
         self.write("position_internal", physics.sensor_counts(), integer=True)
         self.write("motor_temperature", round(physics.temperature))
         self.write("i2t_signal", self.i2t.signal(self.drive_max_current))
-        self.write("i2t_current", min(0x7FFF, round(0x7FFF * math.sqrt(self.i2t.mean_square)
-                                                    / self.drive_max_current)))
+        self.write("i2t_current", min(0x7FFF, round(0x7FFF * math.sqrt(self.i2t.mean_square) / self.drive_max_current)))
         self._linked_bits = self._linked_status_bits()
         warnings = self._warnings()
         if warnings != self.warnings:

@@ -16,8 +16,8 @@ from __future__ import annotations
 
 from servostudio.sim.drive import errors
 from servostudio.sim.drive.behaviour import DriveBehaviour
+from servostudio.sim.drive.device_map import _COMMON_402, DeviceProfile
 from servostudio.sim.drive.errors import DriveError
-from servostudio.sim.drive.profile import _COMMON_402, DeviceProfile
 from servostudio.sim.drive.statemachine import STOP_CURRENT_LIMIT, STOP_NONE, STOP_SLOW_DOWN_RAMP
 from servostudio.sim.drive.units import UnitScaling
 
@@ -26,9 +26,11 @@ FULL_SCALE = 0x3FFF
 CD1K = DeviceProfile(
     key="cd1k",
     objects={
-        name: address for name, address in _COMMON_402.items()
+        name: address
+        for name, address in _COMMON_402.items()
         if address[0] not in (0x60F6, 0x60F9, 0x60FB, 0x6410, 0x6510, 0x6093, 0x6073, 0x6075)
-    } | {
+    }
+    | {
         "kp_current_q": (0x60F6, 1),
         "ki_current_q": (0x60F6, 2),
         "kp_current_d": (0x60F6, 3),

@@ -26,7 +26,9 @@ def commissioned_values(plant: Plant, drive_max_ma: float, drive_rated_ma: float
     rated, maximum = current_limits(plant.stall_current * 1000, plant.peak_current * 1000, drive_max_ma, drive_rated_ma)
     current = gains.current_loop_gains(plant.inductance, 0)
     tuned = gains.tuned_gains(
-        plant.total_inertia, plant.torque_constant, COMMISSIONING_BANDWIDTH_HZ,
+        plant.total_inertia,
+        plant.torque_constant,
+        COMMISSIONING_BANDWIDTH_HZ,
         viscous_friction=plant.viscous_friction,
     )
     return {

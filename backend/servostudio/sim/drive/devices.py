@@ -8,8 +8,8 @@ from __future__ import annotations
 
 from servostudio.sim.drive.behaviour import DriveBehaviour, Events
 from servostudio.sim.drive.cd1k import CD1K, Cd1kBehaviour
+from servostudio.sim.drive.device_map import XTRAPULSPAC, DeviceProfile
 from servostudio.sim.drive.encotrive import ENCOTRIVE, EncoTriveBehaviour
-from servostudio.sim.drive.profile import XTRAPULSPAC, DeviceProfile
 from servostudio.sim.objects import ObjectStore
 from servostudio.sim.plant import Plant
 

@@ -14,17 +14,19 @@ from typing import Any
 from servostudio.sim.drive import gains
 from servostudio.sim.drive.behaviour import DriveBehaviour
 from servostudio.sim.drive.commissioning import COMMISSIONING_BANDWIDTH_HZ
+from servostudio.sim.drive.device_map import _COMMON_402, DeviceProfile
 from servostudio.sim.drive.errors import DriveError
-from servostudio.sim.drive.profile import _COMMON_402, DeviceProfile
 from servostudio.sim.drive.statemachine import STOP_NONE, STOP_QUICK_STOP_RAMP
 from servostudio.sim.drive.units import RPM, UnitScaling
 
 ENCOTRIVE = DeviceProfile(
     key="encotrive",
     objects={
-        name: address for name, address in _COMMON_402.items()
+        name: address
+        for name, address in _COMMON_402.items()
         if address[0] not in (0x60F6, 0x60F9, 0x60FB, 0x6410, 0x6510, 0x6098, 0x6099, 0x609A, 0x607C)
-    } | {"fault_reaction_code": (0x605E, 0), "max_torque": (0x6072, 0)},
+    }
+    | {"fault_reaction_code": (0x605E, 0), "max_torque": (0x6072, 0)},
     modes=frozenset({1, 3}),
     supported_modes_word=0x05,
     default_mode=1,
@@ -70,8 +72,12 @@ class EncoTriveBehaviour(DriveBehaviour):
         current = gains.current_loop_gains(plant.inductance, 0)
         loops.kp_q = loops.kp_d = current.kp_q * gains.CURRENT_KP_UNIT
         loops.ki_q = loops.ki_d = current.ki_q * gains.CURRENT_KI_UNIT
-        tuned = gains.tuned_gains(plant.total_inertia, plant.torque_constant, COMMISSIONING_BANDWIDTH_HZ,
-                                  viscous_friction=plant.viscous_friction)
+        tuned = gains.tuned_gains(
+            plant.total_inertia,
+            plant.torque_constant,
+            COMMISSIONING_BANDWIDTH_HZ,
+            viscous_friction=plant.viscous_friction,
+        )
         scale = tuned.kjv / gains.KJV_ONE
         loops.kpv = tuned.kpv * gains.KPV_UNIT * scale
         loops.kiv = tuned.kiv * gains.KIV_UNIT * scale

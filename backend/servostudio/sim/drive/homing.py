@@ -193,8 +193,8 @@ class Homing:
     def _found(self, position: float) -> None:
         self.home_position = position
         self.status = HomingStatus.FOUND
-        return None
+        return
 
     def _error(self) -> None:
         self.status = HomingStatus.ERROR
-        return None
+        return

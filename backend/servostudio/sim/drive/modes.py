@@ -13,7 +13,7 @@ from typing import TYPE_CHECKING
 from servostudio.sim.drive import errors
 from servostudio.sim.drive.homing import FAST, Homing, HomingInputs, HomingStatus
 from servostudio.sim.drive.loops import MODE_POSITION, MODE_TORQUE, MODE_VELOCITY
-from servostudio.sim.drive.profiles import PositionProfile, SmoothedProfile, VelocityRamp
+from servostudio.sim.drive.setpoints import PositionProfile, SmoothedProfile, VelocityRamp
 
 if TYPE_CHECKING:
     from servostudio.sim.drive.behaviour import DriveBehaviour
@@ -89,8 +89,12 @@ class ProfilePosition(ModeHandler):
         if limit > 0:
             speed = min(speed, limit)
         speed = min(units.speed_to_rad(speed), drive.max_speed)
-        set_point = (target_user, speed, units.accel_to_rad(float(drive.p.get("profile_acceleration", 0))),
-                     units.accel_to_rad(float(drive.p.get("profile_deceleration", 0))))
+        set_point = (
+            target_user,
+            speed,
+            units.accel_to_rad(float(drive.p.get("profile_acceleration", 0))),
+            units.accel_to_rad(float(drive.p.get("profile_deceleration", 0))),
+        )
         self.acknowledged = True
         if control_word & CW_CHANGE_IMMEDIATELY or self.generator.done:
             self.queued = None
@@ -224,7 +228,8 @@ class ProfileVelocity(ModeHandler):
         else:
             self.threshold_time = 0.0
         self.standstill = threshold > 0 and self.threshold_time * 1000.0 >= float(
-            drive.p.get("velocity_threshold_time", 0))
+            drive.p.get("velocity_threshold_time", 0)
+        )
 
     def status_bits(self) -> int:
         self._timers()

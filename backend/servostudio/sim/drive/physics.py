@@ -140,8 +140,10 @@ class AxisPhysics:
             i_q = self.i_q
             decay = self._decay
             gain = self._gain
-            i_d, i_q = (decay * i_d + gain * (v_d + lw * i_q),
-                        decay * i_q + gain * (v_q - lw * i_d - plant.torque_constant * omega / 1.5))
+            i_d, i_q = (
+                decay * i_d + gain * (v_d + lw * i_q),
+                decay * i_q + gain * (v_q - lw * i_d - plant.torque_constant * omega / 1.5),
+            )
         else:
             i_d = i_q = v_d = v_q = 0.0
         self.i_d = i_d
@@ -212,13 +214,19 @@ class AxisPhysics:
             self.omega_motor - self.omega_load
         )
         self.omega_motor = self._brake(
-            self.omega_motor, torque - spring - plant.viscous_friction * 0.1 * self.omega_motor, plant.motor_inertia,
-            plant.coulomb_friction * 0.1, dt,
+            self.omega_motor,
+            torque - spring - plant.viscous_friction * 0.1 * self.omega_motor,
+            plant.motor_inertia,
+            plant.coulomb_friction * 0.1,
+            dt,
         )
         self.theta_motor += self.omega_motor * dt
         self.omega_load = _coulomb_step(
-            self.omega_load, spring - plant.gravity_torque - plant.viscous_friction * 0.9 * self.omega_load,
-            plant.load_inertia, plant.coulomb_friction * 0.9, dt,
+            self.omega_load,
+            spring - plant.gravity_torque - plant.viscous_friction * 0.9 * self.omega_load,
+            plant.load_inertia,
+            plant.coulomb_friction * 0.9,
+            dt,
         )
         self.theta_load += self.omega_load * dt
         self._hard_stops_load()

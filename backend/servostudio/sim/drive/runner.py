@@ -10,6 +10,7 @@ from __future__ import annotations
 from typing import TYPE_CHECKING, Any
 
 from servostudio.sim.drive import errors, gains
+from servostudio.sim.drive.device_map import MODE_PV
 from servostudio.sim.drive.loops import MODE_FORCED_VECTOR, MODE_OFF, MODE_TORQUE
 from servostudio.sim.drive.physics import TWO_PI
 from servostudio.sim.drive.procedures import (
@@ -23,7 +24,6 @@ from servostudio.sim.drive.procedures import (
     ProcedureSlot,
     signature,
 )
-from servostudio.sim.drive.profile import MODE_PV
 from servostudio.sim.drive.statemachine import State
 from servostudio.sim.drive.tuning import AutoTuning, Identified
 
@@ -71,8 +71,9 @@ class ProcedureRunner:
             slot.status = DONE
             return
         if name == "clim":
-            drive.apply_current_limits(float(drive.live("motor_stall_current", 0)),
-                                       float(drive.live("motor_peak_current", 0)))
+            drive.apply_current_limits(
+                float(drive.live("motor_stall_current", 0)), float(drive.live("motor_peak_current", 0))
+            )
             slot.status = DONE
             return
         procedure = self._create(name)
@@ -161,8 +162,9 @@ class ProcedureRunner:
         drive.write("ki_current_q", result.ki_q)
         drive.write("kp_current_d", result.kp_d)
         drive.write("ki_current_d", result.ki_d)
-        drive.apply_current_limits(float(drive.live("motor_stall_current", 0)),
-                                   float(drive.live("motor_peak_current", 0)))
+        drive.apply_current_limits(
+            float(drive.live("motor_stall_current", 0)), float(drive.live("motor_peak_current", 0))
+        )
         drive.parameters_changed()
 
     def _apply_tuning(self, identified: Identified) -> None:
@@ -170,15 +172,26 @@ class ProcedureRunner:
         p = drive.p
         bandwidth = gains.TUNING_BANDWIDTH_HZ.get(int(p.get("tuning_bandwidth", 1)), 75.0)
         result = gains.tuned_gains(
-            identified.inertia, identified.torque_constant, bandwidth,
+            identified.inertia,
+            identified.torque_constant,
+            bandwidth,
             position_loop=drive.active_mode != MODE_PV,
             minimum_following_error=int(p.get("tuning_requirement", 0)) == 0,
             viscous_friction=identified.viscous_friction,
         )
-        for name, value in (("kp_speed", result.kpv), ("ki_speed", result.kiv), ("ki_speed_filter", result.kivf),
-                            ("kc_speed", result.kcv), ("kd_speed", result.kdv), ("kd_speed_filter", result.kdvf),
-                            ("kj_speed", result.kjv), ("kp_position", result.kpp), ("kf_position", result.kfp),
-                            ("ka_position", result.kav), ("kb_position", result.kbv)):
+        for name, value in (
+            ("kp_speed", result.kpv),
+            ("ki_speed", result.kiv),
+            ("ki_speed_filter", result.kivf),
+            ("kc_speed", result.kcv),
+            ("kd_speed", result.kdv),
+            ("kd_speed_filter", result.kdvf),
+            ("kj_speed", result.kjv),
+            ("kp_position", result.kpp),
+            ("kf_position", result.kfp),
+            ("ka_position", result.kav),
+            ("kb_position", result.kbv),
+        ):
             drive.write(name, value)
         selection = int(p.get("tuning_speed_filter", 0))
         drive.write("speed_filter", result.speed_filter if selection == 0 else selection - 1)

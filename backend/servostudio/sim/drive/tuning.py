@@ -80,7 +80,7 @@ class AutoTuning:
         samples = self._samples
         dt = self.dt
         for start in range(0, len(samples) - WINDOW, WINDOW):
-            chunk = samples[start:start + WINDOW + 1]
+            chunk = samples[start : start + WINDOW + 1]
             delta = chunk[-1][0] - chunk[0][0]
             signs = sum(math.copysign(1.0, s) if abs(s) > 0.5 else 0.0 for s, _ in chunk[:-1]) * dt
             integral = sum(s for s, _ in chunk[:-1]) * dt

@@ -14,8 +14,12 @@ RPM = TWO_PI / 60.0
 
 
 class UnitScaling:
-    def __init__(self, user_per_revolution: float = 4096.0, speed_unit_rad: float | None = None,
-                 accel_unit_rad: float | None = None) -> None:
+    def __init__(
+        self,
+        user_per_revolution: float = 4096.0,
+        speed_unit_rad: float | None = None,
+        accel_unit_rad: float | None = None,
+    ) -> None:
         self.user_per_revolution = user_per_revolution
         self._position_unit = TWO_PI / user_per_revolution
         self._speed_unit = speed_unit_rad if speed_unit_rad is not None else self._position_unit

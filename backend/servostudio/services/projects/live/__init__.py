@@ -8,5 +8,16 @@ from servostudio.services.projects.live.service import LiveProjects
 from servostudio.services.projects.live.source import DriveValues
 from servostudio.services.projects.live.sync import DriveWrite, DriveWriteReport, LiveCompare
 
-__all__ = ["AxisLink", "AxisReport", "CommissionReport", "DriveValues", "DriveWrite", "DriveWriteReport",
-           "LiveCompare", "LiveProjects", "ScanReport", "ScannedNode", "link_axes"]
+__all__ = [
+    "AxisLink",
+    "AxisReport",
+    "CommissionReport",
+    "DriveValues",
+    "DriveWrite",
+    "DriveWriteReport",
+    "LiveCompare",
+    "LiveProjects",
+    "ScanReport",
+    "ScannedNode",
+    "link_axes",
+]

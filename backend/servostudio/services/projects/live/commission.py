@@ -33,8 +33,8 @@ from servostudio.services.projects import layout
 from servostudio.services.projects.axisvalues import AxisValues
 from servostudio.services.projects.errors import ConflictError, ProjectError, ValidationError
 from servostudio.services.projects.live.links import AxisLink, link_axes
+from servostudio.services.projects.parameter_values import to_file_value
 from servostudio.services.projects.service import ProjectService
-from servostudio.services.projects.values import to_file_value
 
 Progress = Callable[[dict[str, object]], None]
 DIRECTIONS = ("check", "download", "upload")
@@ -66,14 +66,26 @@ class CommissionReport:
         return all(report.ok for report in self.axes)
 
     def as_dict(self) -> dict[str, object]:
-        return {"project": self.project, "direction": self.direction, "ok": self.ok, "revision": self.revision,
-                "axes": [report.as_dict() for report in self.axes]}
+        return {
+            "project": self.project,
+            "direction": self.direction,
+            "ok": self.ok,
+            "revision": self.revision,
+            "axes": [report.as_dict() for report in self.axes],
+        }
 
 
-def commission(service: ProjectService, manager: ConnectionManager, project: str, direction: str = "check",
-               axes: Iterable[str] | None = None, buses: Mapping[str, str] | None = None,
-               expected_revision: str | None = None, progress: Progress | None = None,
-               cancel: Cancellation | None = None) -> CommissionReport:
+def commission(
+    service: ProjectService,
+    manager: ConnectionManager,
+    project: str,
+    direction: str = "check",
+    axes: Iterable[str] | None = None,
+    buses: Mapping[str, str] | None = None,
+    expected_revision: str | None = None,
+    progress: Progress | None = None,
+    cancel: Cancellation | None = None,
+) -> CommissionReport:
     """Check the chosen axes (all by default), then download or upload the usable ones."""
     if direction not in DIRECTIONS:
         raise ValidationError(f"direction must be one of {', '.join(DIRECTIONS)}, not {direction!r}")
@@ -87,31 +99,43 @@ def commission(service: ProjectService, manager: ConnectionManager, project: str
     with tempfile.TemporaryDirectory(prefix="servostudio-commission-") as scratch:
         if direction == "download":
             copies = _copy_axis_files(service, project, [report.link for report in usable], Path(scratch))
-            _parallel(usable, lambda report: _download(report, copies[report.link.axis.name], Path(scratch),
-                                                       progress, project, cancel))
+            _parallel(
+                usable,
+                lambda report: _download(
+                    report, copies[report.link.axis.name], Path(scratch), progress, project, cancel
+                ),
+            )
         elif direction == "upload":
-            _parallel(usable, lambda report: _backup(report, Path(scratch) / report.link.axis.name, progress,
-                                                     project, cancel))
+            _parallel(
+                usable, lambda report: _backup(report, Path(scratch) / report.link.axis.name, progress, project, cancel)
+            )
             if cancel is not None and cancel.requested:
                 for report in usable:
                     report.error = report.error or "upload cancelled; the project was not changed"
                 return CommissionReport(project, direction, reports, service.store.open(project).revision)
-            revision = _install(service, project, [r for r in usable if not r.error], Path(scratch),
-                                expected_revision or snapshot.revision)
+            revision = _install(
+                service,
+                project,
+                [r for r in usable if not r.error],
+                Path(scratch),
+                expected_revision or snapshot.revision,
+            )
             return CommissionReport(project, direction, reports, revision)
     return CommissionReport(project, direction, reports, service.store.open(project).revision)
 
 
 # ---- download ---------------------------------------------------------------------------------------------------
 
+
 @dataclass(frozen=True)
 class _AxisCopy:
-    directory: Path                       # the axis's files as they were when the download started
+    directory: Path  # the axis's files as they were when the download started
     values: AxisValues
 
 
-def _copy_axis_files(service: ProjectService, project: str, links: list[AxisLink],
-                     scratch: Path) -> dict[str, _AxisCopy]:
+def _copy_axis_files(
+    service: ProjectService, project: str, links: list[AxisLink], scratch: Path
+) -> dict[str, _AxisCopy]:
     """Snapshot the axis files under the project's read lock, so the download sends one consistent state."""
     copies = {}
     with service.store.read(project) as view:
@@ -123,8 +147,14 @@ def _copy_axis_files(service: ProjectService, project: str, links: list[AxisLink
     return copies
 
 
-def _download(report: AxisReport, copy: _AxisCopy, scratch: Path, progress: Progress | None,
-              project: str, cancel: Cancellation | None = None) -> None:
+def _download(
+    report: AxisReport,
+    copy: _AxisCopy,
+    scratch: Path,
+    progress: Progress | None,
+    project: str,
+    cancel: Cancellation | None = None,
+) -> None:
     drive = report.link.drive()
     relay = _relay(progress, project, report.link)
     outgoing = scratch / "download" / report.link.axis.name
@@ -156,8 +186,11 @@ def _complete_file(values: AxisValues, kind: FileKind, path: Path) -> list[str]:
         if variable.save_type is not kind.save_type:
             continue
         value = values.value(variable)
-        entry = ObjectEntry(variable.index, variable.subindex, to_file_value(variable, value)) if value is not None \
+        entry = (
+            ObjectEntry(variable.index, variable.subindex, to_file_value(variable, value))
+            if value is not None
             else None
+        )
         if entry is not None and isinstance(entry.value, str):
             try:
                 format_object_file([entry])
@@ -167,22 +200,29 @@ def _complete_file(values: AxisValues, kind: FileKind, path: Path) -> list[str]:
             left_out.append(variable.label)
         else:
             entries.append(entry)
-    write_object_file(path, entries, header=f"{kind.value}: project values for {values.dictionary.device} node "
-                                            f"{values.node_id}, Servo Studio download")
+    write_object_file(
+        path,
+        entries,
+        header=f"{kind.value}: project values for {values.dictionary.device} node "
+        f"{values.node_id}, Servo Studio download",
+    )
     return left_out
 
 
 # ---- upload -----------------------------------------------------------------------------------------------------
 
-def _backup(report: AxisReport, directory: Path, progress: Progress | None, project: str,
-            cancel: Cancellation | None = None) -> None:
+
+def _backup(
+    report: AxisReport, directory: Path, progress: Progress | None, project: str, cancel: Cancellation | None = None
+) -> None:
     drive: Drive = report.link.drive()
     results = backup_drive(drive, directory, drive_file_kinds(drive), _relay(progress, project, report.link), cancel)
     report.files = [{**result.as_dict(), "file": result.kind, "ok": True} for result in results]
 
 
-def _install(service: ProjectService, project: str, reports: list[AxisReport], scratch: Path,
-             expected_revision: str) -> str:
+def _install(
+    service: ProjectService, project: str, reports: list[AxisReport], scratch: Path, expected_revision: str
+) -> str:
     """Replace the uploaded axes' files in one project change (refused if the project changed meanwhile)."""
     if not reports:
         return service.store.open(project).revision
@@ -197,12 +237,16 @@ def _install(service: ProjectService, project: str, reports: list[AxisReport], s
             if report.error:
                 continue
             for item in report.files:
-                edit.write_axis_file(report.link.axis.name, str(item["file"]),
-                                     (scratch / report.link.axis.name / str(item["file"])).read_bytes())
+                edit.write_axis_file(
+                    report.link.axis.name,
+                    str(item["file"]),
+                    (scratch / report.link.axis.name / str(item["file"])).read_bytes(),
+                )
     return edit.revision
 
 
 # ---- helpers ----------------------------------------------------------------------------------------------------
+
 
 def _parallel(reports: list[AxisReport], work: Callable[[AxisReport], None]) -> None:
     """Run ``work`` for every axis at once; a failure is recorded in that axis's report."""

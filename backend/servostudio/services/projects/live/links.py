@@ -45,11 +45,17 @@ class AxisLink:
         return self.connection.drive(self.axis.node_id, self.axis.device)
 
     def as_dict(self) -> dict[str, object]:
-        return {"axis": self.axis.name, "device": self.axis.device, "node_id": self.axis.node_id,
-                "bus": self.bus.name, "spec": self.spec,
-                "bus_id": self.connection.id if self.connection is not None else None,
-                "status": self.status, "problem": self.problem or None,
-                "identity": self.identity.as_dict() if self.identity is not None else None}
+        return {
+            "axis": self.axis.name,
+            "device": self.axis.device,
+            "node_id": self.axis.node_id,
+            "bus": self.bus.name,
+            "spec": self.spec,
+            "bus_id": self.connection.id if self.connection is not None else None,
+            "status": self.status,
+            "problem": self.problem or None,
+            "identity": self.identity.as_dict() if self.identity is not None else None,
+        }
 
 
 def select_axes(project: Project, names: Iterable[str] | None) -> list[Axis]:
@@ -74,8 +80,12 @@ def open_bus(manager: ConnectionManager, bus: Bus, spec: str, wait: float = CONN
     return connection
 
 
-def link_axes(project: Project, manager: ConnectionManager, names: Iterable[str] | None = None,
-              buses: Mapping[str, str] | None = None) -> list[AxisLink]:
+def link_axes(
+    project: Project,
+    manager: ConnectionManager,
+    names: Iterable[str] | None = None,
+    buses: Mapping[str, str] | None = None,
+) -> list[AxisLink]:
     """Connect the buses of the chosen axes and identify each axis's node. ``buses`` maps a project bus name to
     another spec to use for this session (e.g. the project says ``sim``, the drives are behind socketcand)."""
     axes = select_axes(project, names)
@@ -93,8 +103,9 @@ def link_axes(project: Project, manager: ConnectionManager, names: Iterable[str]
         return list(pool.map(lambda axis: _link(project.bus(axis.bus), axis, *connections[axis.bus]), axes))
 
 
-def link_axis(project: Project, manager: ConnectionManager, axis: str,
-              buses: Mapping[str, str] | None = None) -> AxisLink:
+def link_axis(
+    project: Project, manager: ConnectionManager, axis: str, buses: Mapping[str, str] | None = None
+) -> AxisLink:
     return link_axes(project, manager, [axis], buses)[0]
 
 
@@ -107,8 +118,15 @@ def _link(bus: Bus, axis: Axis, spec: str, connection: BusConnection) -> AxisLin
     if info is None:
         return AxisLink(axis, bus, spec, connection, None, "no_answer", f"{where}: the node does not answer")
     if info.device != axis.device:
-        found = (f"device '{info.device}'" if info.device else "a device no dictionary of the EDS library matches")
-        return AxisLink(axis, bus, spec, connection, info, "wrong_device",
-                        f"{where}: expected device '{axis.device}', found {found} (vendor 0x{info.vendor_id or 0:X}, "
-                        f"product 0x{info.product_code or 0:X}); nothing is written to it")
+        found = f"device '{info.device}'" if info.device else "a device no dictionary of the EDS library matches"
+        return AxisLink(
+            axis,
+            bus,
+            spec,
+            connection,
+            info,
+            "wrong_device",
+            f"{where}: expected device '{axis.device}', found {found} (vendor 0x{info.vendor_id or 0:X}, "
+            f"product 0x{info.product_code or 0:X}); nothing is written to it",
+        )
     return AxisLink(axis, bus, spec, connection, info, "ok")

@@ -20,21 +20,24 @@ from servostudio.services.projects.live.links import AxisLink
 from servostudio.services.projects.live.source import DriveValues
 from servostudio.services.projects.motors import Motor
 from servostudio.services.projects.motorselect import LAYOUTS, MotorDataLayout
+from servostudio.services.projects.parameter_values import display
 from servostudio.services.projects.parameters import ParameterChange, parameter_row
 from servostudio.services.projects.service import AxisChoice, ProjectService
 from servostudio.services.projects.store import Snapshot
-from servostudio.services.projects.values import display
 
 Key = tuple[int, int]
 
 
-def select_motor_live(service: ProjectService, project: str, link: AxisLink, reference: str,
-                      expected_revision: str | None = None) -> AxisChoice:
+def select_motor_live(
+    service: ProjectService, project: str, link: AxisLink, reference: str, expected_revision: str | None = None
+) -> AxisChoice:
     motor = service.motors.get(reference)
     layout = LAYOUTS.get(link.axis.device)
     if layout is None:
-        raise ParameterRefused(f"device '{link.axis.device}' does not take catalog motors (the catalog uses the "
-                               "XtrapulsPac 0x6410 motor data layout)")
+        raise ParameterRefused(
+            f"device '{link.axis.device}' does not take catalog motors (the catalog uses the "
+            "XtrapulsPac 0x6410 motor data layout)"
+        )
     drive = link.drive()
     writes = _motor_writes(motor, layout)
     checked: list[tuple[Variable, object]] = []
@@ -51,14 +54,18 @@ def select_motor_live(service: ProjectService, project: str, link: AxisLink, ref
         try:
             future.result(DEFAULT_WAIT)
         except SdoAbortError as error:
-            raise ParameterRefused(f"the drive refused {variable.label}: {error.reason}; {position} of "
-                                   f"{len(futures)} motor values had been written, the project is unchanged") from None
+            raise ParameterRefused(
+                f"the drive refused {variable.label}: {error.reason}; {position} of "
+                f"{len(futures)} motor values had been written, the project is unchanged"
+            ) from None
     after = DriveValues(drive, watched)
     written = {key for key, _value in writes}
-    notes = [f"the drive set {variable.label}: {display(variable, before.read(*variable.key))} -> "
-             f"{display(variable, after.read(*variable.key))}"
-             for variable in watched if variable.key not in written
-             and before.read(*variable.key) != after.read(*variable.key)]
+    notes = [
+        f"the drive set {variable.label}: {display(variable, before.read(*variable.key))} -> "
+        f"{display(variable, after.read(*variable.key))}"
+        for variable in watched
+        if variable.key not in written and before.read(*variable.key) != after.read(*variable.key)
+    ]
     with service.store.edit(project, expected_revision) as edit:
         values = service.parameters.axis_values(edit, link.axis.name)
         taken = []

@@ -28,13 +28,19 @@ AXIS_PREFIX = "Axis"
 @dataclass(frozen=True)
 class ScannedNode:
     identity: NodeInfo
-    status: str          # added | present | conflict | unknown_device | refused
+    status: str  # added | present | conflict | unknown_device | refused
     axis: str | None = None
     reason: str = ""
 
     def as_dict(self) -> dict[str, object]:
-        return {"node_id": self.identity.node, "device": self.identity.device, "status": self.status,
-                "axis": self.axis, "reason": self.reason or None, "identity": self.identity.as_dict()}
+        return {
+            "node_id": self.identity.node,
+            "device": self.identity.device,
+            "status": self.status,
+            "axis": self.axis,
+            "reason": self.reason or None,
+            "identity": self.identity.as_dict(),
+        }
 
 
 @dataclass(frozen=True)
@@ -45,9 +51,15 @@ class ScanReport:
     snapshot: Snapshot
 
 
-def scan_into_project(service: ProjectService, manager: ConnectionManager, project: str, bus: str,
-                      bus_name: str | None = None, expected_revision: str | None = None,
-                      create: bool = False) -> ScanReport:
+def scan_into_project(
+    service: ProjectService,
+    manager: ConnectionManager,
+    project: str,
+    bus: str,
+    bus_name: str | None = None,
+    expected_revision: str | None = None,
+    create: bool = False,
+) -> ScanReport:
     """Scan ``bus`` (a project bus name or a bus spec) and add an axis for every new identified node; with
     ``create`` a project that does not exist yet is created first (the manual's "project not defined" case)."""
     if create and not any(same_name(name, project) for name in service.store.names()):
@@ -56,8 +68,10 @@ def scan_into_project(service: ProjectService, manager: ConnectionManager, proje
     chosen, added = _choose_bus(snapshot.project, bus, bus_name)
     connection = open_bus(manager, chosen, chosen.interface)
     if not connection.link.connected:
-        raise DriveUnavailable(f"bus '{chosen.name}' ({chosen.interface}) is not connected: "
-                               f"{connection.link.last_error or 'no connection'}")
+        raise DriveUnavailable(
+            f"bus '{chosen.name}' ({chosen.interface}) is not connected: "
+            f"{connection.link.last_error or 'no connection'}"
+        )
     found = scan(connection)
     candidate = replace(snapshot.project, buses=(*snapshot.project.buses, chosen)) if added else snapshot.project
     nodes, new_axes = [], []
@@ -69,8 +83,9 @@ def scan_into_project(service: ProjectService, manager: ConnectionManager, proje
             candidate = candidate.with_axes((*candidate.axes, axis))
             new_axes.append(axis)
     if new_axes or added:
-        snapshot = service.store.add_axes(project, tuple(new_axes), expected_revision or snapshot.revision,
-                                          buses=(chosen,) if added else ())
+        snapshot = service.store.add_axes(
+            project, tuple(new_axes), expected_revision or snapshot.revision, buses=(chosen,) if added else ()
+        )
     return ScanReport(chosen, added, nodes, snapshot)
 
 
@@ -83,8 +98,9 @@ def _choose_bus(project: Project, text: str, new_name: str | None) -> tuple[Bus,
         spec = parse_bus_spec(text)
     except BusSpecError as error:
         buses = ", ".join(bus.name for bus in project.buses) or "none"
-        raise ValidationError(f"'{text}' is neither a bus of project '{project.name}' ({buses}) nor a bus spec: "
-                           f"{error}") from None
+        raise ValidationError(
+            f"'{text}' is neither a bus of project '{project.name}' ({buses}) nor a bus spec: {error}"
+        ) from None
     for existing in project.buses:
         if parse_bus_spec(existing.interface) == spec:
             return existing, False
@@ -106,11 +122,20 @@ def _place(project: Project, bus: Bus, info: NodeInfo, devices: list[str]) -> Sc
     if present is not None:
         if present.device == info.device:
             return ScannedNode(info, "present", present.name)
-        return ScannedNode(info, "conflict", present.name, f"axis '{present.name}' expects device '{present.device}', "
-                           f"the node is {info.device or 'unidentified'}")
+        return ScannedNode(
+            info,
+            "conflict",
+            present.name,
+            f"axis '{present.name}' expects device '{present.device}', the node is {info.device or 'unidentified'}",
+        )
     if info.device is None or info.device not in devices:
-        return ScannedNode(info, "unknown_device", None, f"vendor 0x{info.vendor_id or 0:X}, product "
-                           f"0x{info.product_code or 0:X} match no dictionary of the EDS library")
+        return ScannedNode(
+            info,
+            "unknown_device",
+            None,
+            f"vendor 0x{info.vendor_id or 0:X}, product "
+            f"0x{info.product_code or 0:X} match no dictionary of the EDS library",
+        )
     name = _axis_name(project, info.node, bus)
     try:
         validate_project(project.with_axes((*project.axes, Axis(name, info.device, info.node, bus.name))), devices)

@@ -31,31 +31,75 @@ class LiveProjects:
     def link(self, project: str, axis: str, buses: Mapping[str, str] | None = None) -> AxisLink:
         return link_axis(self.projects.store.open(project).project, self.connections, axis, buses)
 
-    def compare(self, project: str, axis: str, *, group: str | None = None, only_differences: bool = False,
-                buses: Mapping[str, str] | None = None) -> LiveCompare:
-        return compare_with_drive(self.projects.parameters, project, self.link(project, axis, buses), group=group,
-                                  only_differences=only_differences)
+    def compare(
+        self,
+        project: str,
+        axis: str,
+        *,
+        group: str | None = None,
+        only_differences: bool = False,
+        buses: Mapping[str, str] | None = None,
+    ) -> LiveCompare:
+        return compare_with_drive(
+            self.projects.parameters,
+            project,
+            self.link(project, axis, buses),
+            group=group,
+            only_differences=only_differences,
+        )
 
-    def take(self, project: str, axis: str, addresses: Sequence[str] | None = None,
-             expected_revision: str | None = None, buses: Mapping[str, str] | None = None) -> ParameterChange:
-        return take_from_drive(self.projects.parameters, project, self.link(project, axis, buses), addresses,
-                               expected_revision)
+    def take(
+        self,
+        project: str,
+        axis: str,
+        addresses: Sequence[str] | None = None,
+        expected_revision: str | None = None,
+        buses: Mapping[str, str] | None = None,
+    ) -> ParameterChange:
+        return take_from_drive(
+            self.projects.parameters, project, self.link(project, axis, buses), addresses, expected_revision
+        )
 
-    def write(self, project: str, axis: str, addresses: Sequence[str] | None = None, store: bool = False,
-              buses: Mapping[str, str] | None = None) -> DriveWriteReport:
+    def write(
+        self,
+        project: str,
+        axis: str,
+        addresses: Sequence[str] | None = None,
+        store: bool = False,
+        buses: Mapping[str, str] | None = None,
+    ) -> DriveWriteReport:
         return write_to_drive(self.projects.parameters, project, self.link(project, axis, buses), addresses, store)
 
-    def commission(self, project: str, direction: str = "check", axes: Iterable[str] | None = None,
-                   expected_revision: str | None = None, buses: Mapping[str, str] | None = None,
-                   progress: Progress | None = None, cancel: Cancellation | None = None) -> CommissionReport:
-        return commission(self.projects, self.connections, project, direction, axes, buses, expected_revision,
-                          progress, cancel)
+    def commission(
+        self,
+        project: str,
+        direction: str = "check",
+        axes: Iterable[str] | None = None,
+        expected_revision: str | None = None,
+        buses: Mapping[str, str] | None = None,
+        progress: Progress | None = None,
+        cancel: Cancellation | None = None,
+    ) -> CommissionReport:
+        return commission(
+            self.projects, self.connections, project, direction, axes, buses, expected_revision, progress, cancel
+        )
 
-    def scan(self, project: str, bus: str, bus_name: str | None = None, expected_revision: str | None = None,
-             create: bool = False) -> ScanReport:
+    def scan(
+        self,
+        project: str,
+        bus: str,
+        bus_name: str | None = None,
+        expected_revision: str | None = None,
+        create: bool = False,
+    ) -> ScanReport:
         return scan_into_project(self.projects, self.connections, project, bus, bus_name, expected_revision, create)
 
-    def select_motor(self, project: str, axis: str, reference: str, expected_revision: str | None = None,
-                     buses: Mapping[str, str] | None = None) -> AxisChoice:
-        return select_motor_live(self.projects, project, self.link(project, axis, buses), reference,
-                                 expected_revision)
+    def select_motor(
+        self,
+        project: str,
+        axis: str,
+        reference: str,
+        expected_revision: str | None = None,
+        buses: Mapping[str, str] | None = None,
+    ) -> AxisChoice:
+        return select_motor_live(self.projects, project, self.link(project, axis, buses), reference, expected_revision)

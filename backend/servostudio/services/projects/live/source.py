@@ -15,7 +15,7 @@ from collections.abc import Iterable
 from servostudio.drive.access import DEFAULT_WAIT, Drive
 from servostudio.drive.sdo import SdoAbortError
 from servostudio.od import Variable
-from servostudio.services.projects.values import Value
+from servostudio.services.projects.parameter_values import Value
 
 Key = tuple[int, int]
 
@@ -26,7 +26,7 @@ class DriveValues:
     def __init__(self, drive: Drive, variables: Iterable[Variable]) -> None:
         self.drive = drive
         self.values: dict[Key, Value] = {}
-        self.refused: dict[Key, str] = {}   # object -> the drive's reason (SDO abort)
+        self.refused: dict[Key, str] = {}  # object -> the drive's reason (SDO abort)
         readable = [var for var in variables if var.access.readable]
         outcomes = drive.submit_read_all(readable).future.result(DEFAULT_WAIT)
         for variable, outcome in zip(readable, outcomes):

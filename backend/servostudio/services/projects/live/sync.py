@@ -19,8 +19,8 @@ from servostudio.services.projects.compare import CompareRow
 from servostudio.services.projects.errors import ParameterRefused
 from servostudio.services.projects.live.links import AxisLink
 from servostudio.services.projects.live.source import DriveValues
+from servostudio.services.projects.parameter_values import Value, display
 from servostudio.services.projects.parameters import ParameterChange, ParameterService
-from servostudio.services.projects.values import Value, display
 
 
 def address_of(variable: Variable) -> str:
@@ -31,21 +31,33 @@ def address_of(variable: Variable) -> str:
 class LiveCompare:
     rows: list[CompareRow]
     revision: str
-    refused: dict[str, str]     # objects the drive refused to read: address -> reason
+    refused: dict[str, str]  # objects the drive refused to read: address -> reason
 
 
-def compare_with_drive(parameters: ParameterService, project: str, link: AxisLink, *, group: str | None = None,
-                       only_differences: bool = False) -> LiveCompare:
+def compare_with_drive(
+    parameters: ParameterService,
+    project: str,
+    link: AxisLink,
+    *,
+    group: str | None = None,
+    only_differences: bool = False,
+) -> LiveCompare:
     """Columns drive / project / default; all drive reads are queued at once."""
     source = DriveValues(link.drive(), parameters.transferable(project, link.axis.name, group))
-    rows, revision = parameters.compare(project, link.axis.name, group=group, only_differences=only_differences,
-                                        drive=source)
+    rows, revision = parameters.compare(
+        project, link.axis.name, group=group, only_differences=only_differences, drive=source
+    )
     refused = {f"0x{index:04X},{sub}": reason for (index, sub), reason in source.refused.items()}
     return LiveCompare(rows, revision, refused)
 
 
-def take_from_drive(parameters: ParameterService, project: str, link: AxisLink, addresses: Sequence[str] | None,
-                    expected_revision: str | None = None) -> ParameterChange:
+def take_from_drive(
+    parameters: ParameterService,
+    project: str,
+    link: AxisLink,
+    addresses: Sequence[str] | None,
+    expected_revision: str | None = None,
+) -> ParameterChange:
     """Store the drive's values of the given objects (None: every object whose drive value differs) in the project;
     any refusal leaves the project unchanged."""
     axis = link.axis.name
@@ -71,14 +83,19 @@ def take_from_drive(parameters: ParameterService, project: str, link: AxisLink, 
 class DriveWrite:
     variable: Variable
     value: Value
-    status: str = "not written"      # written | failed | not written
+    status: str = "not written"  # written | failed | not written
     error: str = ""
     read_back: Value | None = None
 
     def as_dict(self) -> dict[str, object]:
-        return {"address": address_of(self.variable), "name": self.variable.label,
-                "value": display(self.variable, self.value), "status": self.status, "error": self.error or None,
-                "drive": display(self.variable, self.read_back)}
+        return {
+            "address": address_of(self.variable),
+            "name": self.variable.label,
+            "value": display(self.variable, self.value),
+            "status": self.status,
+            "error": self.error or None,
+            "drive": display(self.variable, self.read_back),
+        }
 
 
 @dataclass
@@ -92,12 +109,17 @@ class DriveWriteReport:
         return all(write.status == "written" for write in self.writes)
 
     def as_dict(self) -> dict[str, object]:
-        return {"axis": self.axis, "ok": self.ok, "stored": self.stored,
-                "objects": [write.as_dict() for write in self.writes]}
+        return {
+            "axis": self.axis,
+            "ok": self.ok,
+            "stored": self.stored,
+            "objects": [write.as_dict() for write in self.writes],
+        }
 
 
-def write_to_drive(parameters: ParameterService, project: str, link: AxisLink, addresses: Sequence[str] | None,
-                   store: bool = False) -> DriveWriteReport:
+def write_to_drive(
+    parameters: ParameterService, project: str, link: AxisLink, addresses: Sequence[str] | None, store: bool = False
+) -> DriveWriteReport:
     """Write the project's values of the given objects (None: every object whose drive value differs) to the drive;
     with ``store`` the drive then saves its parameters to flash (the profile's 'save' procedure)."""
     axis = link.axis.name
@@ -113,8 +135,9 @@ def write_to_drive(parameters: ParameterService, project: str, link: AxisLink, a
     writes = [DriveWrite(variable, value) for variable, value in chosen]
     for write in writes:  # everything is checked before the first frame is sent
         if write.value is None:
-            raise ParameterRefused(f"{write.variable.label}: the project has no value for it (no default, not set); "
-                                   "nothing was written")
+            raise ParameterRefused(
+                f"{write.variable.label}: the project has no value for it (no default, not set); nothing was written"
+            )
         try:
             drive.prepare_write(write.variable, write.value)
         except DriveAccessError as error:

@@ -1,6 +1,6 @@
 /** Typed access to the communication server's REST API (same origin). */
 
-import type { Dictionary, DictionarySummary, Scalar } from "./lib/od";
+import type { Dictionary, DictionarySummary, Scalar } from "../lib/od";
 
 export interface Health {
   status: string;

@@ -111,16 +111,26 @@ class ObjectValue:
     def bits(self) -> list[dict[str, object]]:
         if not isinstance(self.raw, int):
             return []
-        return [{"name": field.name, "first": field.first, "last": field.last, "value": field.extract(self.raw)}
-                for field in self.variable.bits]
+        return [
+            {"name": field.name, "first": field.first, "last": field.last, "value": field.extract(self.raw)}
+            for field in self.variable.bits
+        ]
 
     def as_dict(self) -> dict[str, object]:
         var = self.variable
         raw = self.raw.hex() if isinstance(self.raw, bytes) else self.raw
         physical = self.physical
         return {
-            "node": self.node, "index": var.index, "sub": var.subindex, "name": var.name, "label": var.label,
-            "data_type": DataType(var.data_type).name, "access": var.access.value, "raw": raw,
-            "physical": physical.hex() if isinstance(physical, bytes) else physical, "unit": var.unit,
-            "text": self.text, "bits": self.bits(),
+            "node": self.node,
+            "index": var.index,
+            "sub": var.subindex,
+            "name": var.name,
+            "label": var.label,
+            "data_type": DataType(var.data_type).name,
+            "access": var.access.value,
+            "raw": raw,
+            "physical": physical.hex() if isinstance(physical, bytes) else physical,
+            "unit": var.unit,
+            "text": self.text,
+            "bits": self.bits(),
         }

@@ -124,7 +124,8 @@ _COMMON_402: dict[str, Address] = {
 
 XTRAPULSPAC = DeviceProfile(
     key="xtrapulspac",
-    objects=_COMMON_402 | {
+    objects=_COMMON_402
+    | {
         "device_id": (0x200A, 1),
         "drive_voltage": (0x6510, 3),
         "operating_voltage": (0x6510, 4),

@@ -1,7 +1,7 @@
 /** The communication server's bus and drive routes (`/api/buses/…`): objects, state, faults, scan, NMT. */
 
 import { get, post, put, request, projectAddress } from "./api";
-import type { Scalar } from "./lib/od";
+import type { Scalar } from "../lib/od";
 
 const e = encodeURIComponent;
 

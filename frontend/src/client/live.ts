@@ -7,7 +7,7 @@
 
 import { setMotionClient, type AxisConfig } from "./api";
 import { busNames } from "./drives";
-import { STATE_LABELS, decodeState, type DriveState } from "./lib/cia402";
+import { STATE_LABELS, decodeState, type DriveState } from "../lib/cia402";
 
 export interface AxisStatus {
   online: boolean;
