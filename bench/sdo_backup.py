@@ -34,7 +34,7 @@ from pathlib import Path
 import canopen
 
 from servostudio.drive.link import BusLink
-from servostudio.drive.sdo import SdoEngine
+from servostudio.drive.sdo import SdoEngine, SdoError
 from servostudio.od import builtin_library
 from servostudio.od.model import SaveType
 from servostudio.services.backup import FileKind, backup_file, backup_objects, run_per_drive
@@ -188,7 +188,7 @@ def backup_objects_of(bench: Bench, node: int) -> list[tuple[int, int, bytes]]:
     for var, future in futures:
         try:
             objects.append((var.index, var.subindex, future.result()))
-        except Exception:
+        except SdoError:  # a value the drive refuses to give still costs its transfer: a placeholder of 4 bytes
             objects.append((var.index, var.subindex, b"\0\0\0\0"))
     return objects
 

@@ -7,10 +7,15 @@
    rows are shown (this includes the editor's 60 ms typing debounce).
 
 Each figure is the median of several runs. Run: `.venv/bin/python bench/ui_load.py` (after `make frontend`).
+
+`--baseline REF` (default `HEAD`, `none` to skip) also builds the UI of git revision REF into a temporary directory
+and measures it side by side with the working tree's build, the runs interleaved (REF, ours, REF, ours, …) so that
+both see the same machine load: the figures that matter are the ratios ours / REF.
 """
 
 from __future__ import annotations
 
+import argparse
 import os
 import shutil
 import socket
@@ -167,17 +172,15 @@ def free_port() -> int:
         return sock.getsockname()[1]
 
 
-def start_server(scratch: Path) -> tuple[subprocess.Popen, str]:
+def start_server(scratch: Path, ui_dir: Path) -> tuple[subprocess.Popen, str]:
+    """`servostudio serve` of the working tree, serving the UI built in `ui_dir`, with the demo project."""
     projects = scratch / "projects"
     shutil.copytree(REPO / "projects" / "demo", projects / "demo")
     port = free_port()
     env = {**os.environ, "SERVOSTUDIO_USER_EDS_DIR": str(scratch / "user-eds"), "PYTHONUNBUFFERED": "1"}
+    command = [sys.executable, "-m", "servostudio", "serve", "--port", str(port), "--projects", str(projects)]
     process = subprocess.Popen(
-        [sys.executable, "-m", "servostudio", "serve", "--port", str(port), "--projects", str(projects)],
-        cwd=REPO,
-        env=env,
-        stdout=subprocess.DEVNULL,
-        stderr=subprocess.DEVNULL,
+        [*command, "--ui", str(ui_dir)], cwd=REPO, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL
     )
     url = f"http://127.0.0.1:{port}"
     deadline = time.monotonic() + 60
@@ -189,6 +192,110 @@ def start_server(scratch: Path) -> tuple[subprocess.Popen, str]:
             time.sleep(0.2)
     process.kill()
     raise SystemExit("server did not start within 60 s")
+
+
+def build_revision(revision: str, scratch: Path) -> Path:
+    """The browser UI of git revision `revision`, built by its own package-lock into `scratch/ui`."""
+    tree = scratch / "tree"
+    subprocess.run(
+        ["git", "worktree", "add", "--detach", str(tree), revision], cwd=REPO, check=True, stdout=subprocess.DEVNULL
+    )
+    try:
+        frontend = tree / "frontend"
+        subprocess.run(["npm", "ci", "--no-audit", "--no-fund", "--silent"], cwd=frontend, check=True)
+        out = scratch / "ui"
+        subprocess.run(
+            ["npx", "vite", "build", "--outDir", str(out), "--emptyOutDir"],
+            cwd=frontend,
+            check=True,
+            stdout=subprocess.DEVNULL,
+        )
+        return out
+    finally:
+        subprocess.run(["git", "worktree", "remove", "--force", str(tree)], cwd=REPO, check=False)
+
+
+def import_dictionary(url: str, scratch: Path) -> tuple[str, int, int]:
+    """Import the generated dictionary through the REST API; its device key, object and entry counts."""
+    eds, props = synthetic_eds(scratch)
+    with eds.open("rb") as eds_file, props.open("rb") as props_file:
+        answer = httpx.post(
+            url + "/api/dictionaries",
+            timeout=120,
+            files={"eds": (eds.name, eds_file), "props": (props.name, props_file)},
+        )
+    answer.raise_for_status()
+    device = answer.json()["device"]
+    dictionary = httpx.get(f"{url}/api/dictionaries/{device}", timeout=60).json()
+    return device, len(dictionary["objects"]), sum(len(item["subs"]) for item in dictionary["objects"])
+
+
+def parse_args() -> argparse.Namespace:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--baseline", default="HEAD", help="git revision to compare with, or 'none' (default HEAD)")
+    return parser.parse_args()
+
+
+def main() -> None:
+    args = parse_args()
+    ours = REPO / "backend" / "servostudio" / "static"
+    if not (ours / "index.html").is_file():
+        raise SystemExit("the UI is not built: run `make frontend` first")
+    chromium = shutil.which("chromium")
+    if chromium is None:
+        raise SystemExit("Debian's chromium is needed: apt-get install chromium")
+    with tempfile.TemporaryDirectory() as folder:
+        scratch = Path(folder)
+        builds = {"working tree": ours}
+        if args.baseline != "none":
+            (scratch / "baseline").mkdir()
+            builds = {args.baseline: build_revision(args.baseline, scratch / "baseline"), **builds}
+        results, counts = run_side_by_side(chromium, builds, scratch)
+    report(results, counts)
+
+
+def run_side_by_side(
+    chromium: str, builds: dict[str, Path], scratch: Path
+) -> tuple[dict[str, dict[str, float | str]], tuple[int, int]]:
+    servers: dict[str, tuple[subprocess.Popen, str, str]] = {}
+    counts = (0, 0)
+    try:
+        for number, (label, ui_dir) in enumerate(builds.items()):
+            (scratch / str(number)).mkdir()
+            process, url = start_server(scratch / str(number), ui_dir)
+            servers[label] = (process, url, "")
+            device, objects, entries = import_dictionary(url, scratch / str(number))
+            servers[label] = (process, url, device)
+            counts = (objects, entries)
+        targets = {label: (url, device) for label, (_, url, device) in servers.items()}
+        return measure(chromium, targets), counts
+    finally:
+        for process, _, _ in servers.values():
+            process.terminate()
+            process.wait(timeout=10)
+
+
+ROWS = [
+    ("main", "main page interactive (tree and server state shown)"),
+    ("dcl", "main page DOMContentLoaded"),
+    ("render", "{objects}-object dictionary ({entries} entries) shown in the editor"),
+    ("fetch", "  of which fetching the dictionary"),
+    ("filter", "filter {entries} entries on a keystroke (incl. 60 ms debounce)"),
+]
+
+
+def report(results: dict[str, dict[str, float | str]], counts: tuple[int, int]) -> None:
+    labels = list(results)
+    print(
+        f"medians in ms of {RUNS} interleaved runs; columns: {', '.join(labels)}"
+        + (", ratio" if len(labels) == 2 else "")
+    )
+    for key, title in ROWS:
+        values = [float(results[label][key]) for label in labels]
+        ratio = f"  {values[1] / values[0]:.2f}x" if len(values) == 2 and values[0] else ""
+        cells = "  ".join(f"{value:7.0f}" for value in values)
+        print(f"{title.format(objects=counts[0], entries=counts[1]):70s} {cells}{ratio}")
+    print(f'last filter result: "{results[labels[-1]]["label"]}"')
 
 
 FILTER_SCRIPT = """async (text) => {
@@ -210,80 +317,44 @@ FILTER_SCRIPT = """async (text) => {
 }"""
 
 
-def main() -> None:
-    if not (REPO / "backend" / "servostudio" / "static" / "index.html").is_file():
-        raise SystemExit("the UI is not built: run `make frontend` first")
-    chromium = shutil.which("chromium")
-    if chromium is None:
-        raise SystemExit("Debian's chromium is needed: apt-get install chromium")
-    with tempfile.TemporaryDirectory() as folder:
-        scratch = Path(folder)
-        process, url = start_server(scratch)
-        try:
-            eds, props = synthetic_eds(scratch)
-            with eds.open("rb") as eds_file, props.open("rb") as props_file:
-                answer = httpx.post(
-                    url + "/api/dictionaries",
-                    timeout=120,
-                    files={"eds": (eds.name, eds_file), "props": (props.name, props_file)},
-                )
-            answer.raise_for_status()
-            device = answer.json()["device"]
-            dictionary = httpx.get(f"{url}/api/dictionaries/{device}", timeout=60).json()
-            entries = sum(len(item["subs"]) for item in dictionary["objects"])
-            results = measure(chromium, url, device)
-        finally:
-            process.terminate()
-            process.wait(timeout=10)
-    print(f"main page interactive (tree and server state shown): median {results['main']:.0f} ms")
-    print(f"main page DOMContentLoaded: median {results['dcl']:.0f} ms")
-    print(
-        f"{len(dictionary['objects'])}-object dictionary ({entries} entries) shown in the editor: median {results['render']:.0f} ms "
-        f"(of which fetching the dictionary: {results['fetch']:.0f} ms)"
-    )
-    print(
-        f"filter {entries} entries on a keystroke (incl. 60 ms debounce): median {results['filter']:.0f} ms "
-        f'("{results["label"]}")'
-    )
-
-
-def measure(chromium: str, url: str, device: str) -> dict[str, float | str]:
-    main_times, dcl_times, render_times, fetch_times, filter_times = [], [], [], [], []
-    label = ""
+def measure(chromium: str, targets: dict[str, tuple[str, str]]) -> dict[str, dict[str, float | str]]:
+    """Every figure for every target, runs interleaved; the median of each."""
+    samples: dict[str, dict[str, list[float]]] = {label: {key: [] for key, _ in ROWS} for label in targets}
+    labels: dict[str, str] = {}
     with sync_playwright() as playwright:
         browser = playwright.chromium.launch(executable_path=chromium, headless=True, args=CHROMIUM_ARGS)
         for _ in range(RUNS):
-            context = browser.new_context(viewport={"width": 1366, "height": 768}, locale="de-DE")
-            page = context.new_page()
-            start = time.perf_counter()
-            page.goto(url + "/")
-            page.wait_for_selector("[data-testid=tree-project-demo]")
-            page.wait_for_selector("[data-testid=server-status][data-state=online]")
-            main_times.append((time.perf_counter() - start) * 1000)
-            dcl_times.append(page.evaluate("performance.getEntriesByType('navigation')[0].domContentLoadedEventEnd"))
-
-            start = time.perf_counter()
-            page.goto(f"{url}/dictionaries/{device}")
-            page.wait_for_selector(".prow.entry")
-            render_times.append((time.perf_counter() - start) * 1000)
-            fetch_times.append(
-                page.evaluate(
-                    f"performance.getEntriesByName(location.origin + '/api/dictionaries/{device}')[0].duration"
-                )
-            )
-            for text in ("gain 3", "filter 5", "0x2100", "Parameter 999"):
-                elapsed, label = page.evaluate(FILTER_SCRIPT, text)
-                filter_times.append(elapsed)
-            context.close()
+            for label, (url, device) in targets.items():
+                labels[label] = one_run(browser, url, device, samples[label])
         browser.close()
     return {
-        "main": statistics.median(main_times),
-        "dcl": statistics.median(dcl_times),
-        "render": statistics.median(render_times),
-        "fetch": statistics.median(fetch_times),
-        "filter": statistics.median(filter_times),
-        "label": label,
+        label: {**{key: statistics.median(values) for key, values in figures.items()}, "label": labels[label]}
+        for label, figures in samples.items()
     }
+
+
+def one_run(browser, url: str, device: str, samples: dict[str, list[float]]) -> str:
+    context = browser.new_context(viewport={"width": 1366, "height": 768}, locale="de-DE")
+    page = context.new_page()
+    start = time.perf_counter()
+    page.goto(url + "/")
+    page.wait_for_selector("[data-testid=tree-project-demo]")
+    page.wait_for_selector("[data-testid=server-status][data-state=online]")
+    samples["main"].append((time.perf_counter() - start) * 1000)
+    samples["dcl"].append(page.evaluate("performance.getEntriesByType('navigation')[0].domContentLoadedEventEnd"))
+    start = time.perf_counter()
+    page.goto(f"{url}/dictionaries/{device}")
+    page.wait_for_selector(".prow.entry")
+    samples["render"].append((time.perf_counter() - start) * 1000)
+    samples["fetch"].append(
+        page.evaluate(f"performance.getEntriesByName(location.origin + '/api/dictionaries/{device}')[0].duration")
+    )
+    label = ""
+    for text in ("gain 3", "filter 5", "0x2100", "Parameter 999"):
+        elapsed, label = page.evaluate(FILTER_SCRIPT, text)
+        samples["filter"].append(elapsed)
+    context.close()
+    return label
 
 
 if __name__ == "__main__":

@@ -1,84 +1,31 @@
-"""Fixtures shared by the whole suite: a real server process on a free localhost port."""
+"""Suite-wide set-up: the shared fixture modules of `tests/support/` and the interpreter's thread switch interval.
+
+The fixtures live in importable modules (not in folder conftests) because the test folders mirror the package:
+the simulated drives over socketcand, for example, serve the drive, services, API and CLI folders alike.
+Folder-specific fixtures stay in the conftest of their folder.
+"""
 
 from __future__ import annotations
 
-import os
-import socket
-import subprocess
 import sys
-import time
-from pathlib import Path
 
-import httpx
 import pytest
 
-REPO_ROOT = Path(__file__).resolve().parent.parent
+pytest_plugins = [
+    "tests.support.canopen_peers",
+    "tests.support.embedded_sim",
+    "tests.support.live_server",
+    "tests.support.sim_endpoints",
+]
 
 
-def free_port() -> int:
-    with socket.socket() as sock:
-        sock.bind(("127.0.0.1", 0))
-        return sock.getsockname()[1]
-
-
-class LiveServer:
-    """`servostudio serve` in a child process, as a user would start it."""
-
-    def __init__(self, projects_dir: Path, extra_args: list[str] | None = None) -> None:
-        self.port = free_port()
-        self.url = f"http://127.0.0.1:{self.port}"
-        command = [
-            sys.executable,
-            "-m",
-            "servostudio",
-            "serve",
-            "--port",
-            str(self.port),
-            "--projects",
-            str(projects_dir),
-            *(extra_args or []),
-        ]
-        self.log = projects_dir.parent / f"server-{self.port}.log"
-        self._log_file = self.log.open("wb")
-        self.process = subprocess.Popen(
-            command,
-            cwd=REPO_ROOT,
-            stdout=self._log_file,
-            stderr=subprocess.STDOUT,
-            env={**os.environ, "PYTHONUNBUFFERED": "1"},
-        )
-
-    def wait_ready(self, timeout: float = 30.0) -> None:
-        deadline = time.monotonic() + timeout
-        while time.monotonic() < deadline:
-            if self.process.poll() is not None:
-                raise RuntimeError(f"server exited with {self.process.returncode}:\n{self.log.read_text()}")
-            try:
-                if httpx.get(f"{self.url}/api/health", timeout=1.0).status_code == 200:
-                    return
-            except httpx.HTTPError:
-                time.sleep(0.1)
-        raise TimeoutError(f"server not ready after {timeout} s:\n{self.log.read_text()}")
-
-    def stop(self) -> None:
-        self.process.terminate()
-        try:
-            self.process.wait(timeout=10)
-        except subprocess.TimeoutExpired:
-            self.process.kill()
-            self.process.wait()
-        self._log_file.close()
-
-
-# Module scope: the server runs three simulated drives in real time; it must not outlive the tests using it.
-@pytest.fixture(scope="module")
-def live_server(tmp_path_factory: pytest.TempPathFactory):
-    root = tmp_path_factory.mktemp("live")
-    projects = root / "projects"
-    projects.mkdir()
-    server = LiveServer(projects)
-    try:
-        server.wait_ready()
-        yield server
-    finally:
-        server.stop()
+@pytest.fixture(autouse=True, scope="session")
+def short_switch_interval():
+    """The simulated drives, the bus reader, the socket threads and the test share one interpreter: a short GIL
+    switch interval keeps each hand-over (and so every SDO round trip) at a fraction of a millisecond instead of
+    5 ms. One setting for the whole session (the suite always ran under it once the live project fixtures were
+    collected); the interpreter's setting is restored afterwards."""
+    previous = sys.getswitchinterval()
+    sys.setswitchinterval(0.0002)
+    yield
+    sys.setswitchinterval(previous)

@@ -14,7 +14,7 @@ from pathlib import Path
 import httpx
 import pytest
 from playwright.sync_api import Browser, Page, expect, sync_playwright
-from tests.conftest import REPO_ROOT, LiveServer
+from tests.support.live_server import REPO_ROOT, LiveServer
 
 # The test machine is shared and slow at times: allow pages more than Playwright's default 5 s to settle.
 expect.set_options(timeout=15_000)
@@ -113,3 +113,10 @@ def demo_server(tmp_path_factory: pytest.TempPathFactory):
 def live_server(demo_server: DemoServer) -> DemoServer:
     """The browser tests share one server (each runs three simulated drives in real time on a 2-core machine)."""
     return demo_server
+
+
+def xtrapulspac_entries() -> int:
+    """How many entries the editor lists for the XtrapulsPac: every sub-entry of its dictionary, from the EDS."""
+    from servostudio.od import BUILTIN_EDS_DIR, EdsLibrary
+
+    return len(EdsLibrary(BUILTIN_EDS_DIR).load("xtrapulspac"))

@@ -2,7 +2,9 @@
 
 from playwright.sync_api import Page, expect
 
-from .conftest import DemoServer, screenshot
+from .conftest import DemoServer, screenshot, xtrapulspac_entries
+
+ENTRIES = xtrapulspac_entries()
 
 
 def test_kpv_found_changed_on_the_drive_and_persisted(page: Page, demo_server: DemoServer) -> None:
@@ -15,7 +17,7 @@ def test_kpv_found_changed_on_the_drive_and_persisted(page: Page, demo_server: D
     search.fill("KPv")
     row = page.locator('.prow.entry[data-address="0x60F9.2"]')
     expect(row).to_be_visible()
-    expect(page.get_by_test_id("param-count")).to_have_text("1 of 882 entries")
+    expect(page.get_by_test_id("param-count")).to_have_text(f"1 of {ENTRIES} entries")
     row.click()
     before = demo_server.api(
         "GET", f"/api/buses/{demo_server.bus}/nodes/{node}/objects/0x60F9,2?device=xtrapulspac"
@@ -93,12 +95,12 @@ def test_application_template_limits_the_editor_to_its_groups(page: Page, demo_s
     group = page.get_by_test_id("param-group")
     expect(group).to_have_value("@application")
     count = page.get_by_test_id("param-count")
-    expect(count).not_to_have_text("882 of 882 entries")
+    expect(count).not_to_have_text(f"{ENTRIES} of {ENTRIES} entries")
     shown = {text for text in page.locator(".prow.group").all_inner_texts()}
     assert shown and all(any(name in text for name in template["groups"]) for text in shown), shown
 
     group.select_option("")  # All groups (Expert)
-    expect(count).to_have_text("882 of 882 entries")
+    expect(count).to_have_text(f"{ENTRIES} of {ENTRIES} entries")
     page.reload()
     expect(page.get_by_test_id("param-group")).to_have_value("")
     screenshot(page, "parameters-application-groups")

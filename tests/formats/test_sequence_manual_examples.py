@@ -18,7 +18,7 @@ FIXTURES = Path(__file__).parent / "fixtures"
 
 
 def test_manual_file_example_is_rejected_for_its_out_of_range_times() -> None:
-    """decisions.md §3: AccelTime=200000 exceeds the U16 ms range of sub 19; so does DecelTime (sub 20)."""
+    """docs/decisions.md §3: AccelTime=200000 exceeds the U16 ms range of sub 19; so does DecelTime (sub 20)."""
     path = FIXTURES / "manual_sequence_example.txt"
     with pytest.raises(SequenceFileError) as caught:
         read_sequence_file(path)

@@ -1,4 +1,4 @@
-"""One test per SEQUENCE.TXT syntax rule (manual L11128–11170, decisions.md §3): accepted forms and rejections.
+"""One test per SEQUENCE.TXT syntax rule (manual L11128–11170, docs/decisions.md §3): accepted forms and rejections.
 
 Each rejection names the line, the keyword as written, and the reason (with the allowed range or values).
 """
@@ -328,7 +328,7 @@ def test_rule9_default_parameters_that_do_not_fit_a_type_are_not_applied_to_it()
     assert table[2]["PosType"] == 1 and "Method" not in table[1].values
 
 
-# Patterns (decisions.md §3): 8 characters of 1/0/., MSB first, in double quotes.
+# Patterns (docs/decisions.md §3): 8 characters of 1/0/., MSB first, in double quotes.
 def test_pattern_strings_are_msb_first() -> None:
     sequence = parse_sequence_text('SeqNb=1\nSeqType=POS\nOutput="1......0"\nEndCond="0.1....."\n')[1]
     assert sequence["Output"] == BitPattern(zeros=0x01, ones=0x80)

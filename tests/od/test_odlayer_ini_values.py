@@ -43,7 +43,7 @@ def test_format_then_parse_gives_back_sections_keys_values_and_lines(document) -
     ini = parse_ini(text, Path("doc.ini"))
     lines = text.splitlines()
     assert [section.name for section in ini] == [name for name, _ in document]
-    for (name, entries), section in zip(document, ini):
+    for (name, entries), section in zip(document, ini, strict=True):
         assert lines[section.line - 1] == f"[{name}]"
         assert [(entry.key, entry.value) for entry in section] == entries
         for key, value in entries:

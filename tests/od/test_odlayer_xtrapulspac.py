@@ -1,6 +1,7 @@
-"""The built-in XtrapulsPac dictionary against the manual (seed 000, object list §3.3 L15497-16464 and the body).
+"""The built-in XtrapulsPac dictionary against the manual (*XtrapulsPac User Guide*, object list §3.3 L15497-16464
+and the body).
 
-The expected indices and values are written here from /work/shared/spec/xtrapulspac-*.md, not from the EDS.
+The expected indices and values are written here from the manual, not from the EDS.
 """
 
 from __future__ import annotations
@@ -357,7 +358,7 @@ DEFINED_IN_BODY_ONLY = {
     0x3829,
     0x30A2,
     0x3059,
-    0x5801,  # the oscilloscope buffer (decisions.md §2, layout in docs/eds.md)
+    0x5801,  # the oscilloscope buffer (docs/decisions.md §2, layout in docs/eds.md)
 }
 
 MANUAL_GROUPS = {
@@ -554,9 +555,9 @@ def test_oscilloscope_layout(od) -> None:
         4: "Done",
     }
     assert od[0x5828, 0].enum == {0: "Stop", 1: "Arm", 2: "Force trigger"}
-    assert od[0x5820, 2].enum == {0: "Immediate", 1: "Edge"} and od[0x5820, 3].enum == {
-        0: "Single shot",
-        1: "Auto re-arm",
-    }
+    assert od[0x5820, 2].enum == {0: "Immediate", 1: "Edge"}
+    assert od[0x5820, 3].enum == {0: "Single", 1: "Normal", 2: "Auto"}
+    assert od[0x5820, 4].data_type is DataType.UNSIGNED16 and od[0x5820, 4].unit == "ms"
+    assert od[0x5828, 0].pdo_mappable and od[0x5829, 0].pdo_mappable  # arm several drives with one RPDO
     assert od[0x5822, 2].enum == {0: "Rising", 1: "Falling", 2: "Either"}
     assert od[0x5805, 0].data_type is DataType.UNSIGNED16 and od[0x5822, 1].data_type is DataType.INTEGER32

@@ -1,57 +1,55 @@
 """FastAPI application factory.
 
-The app is built by :func:`create_app` so tests and the CLI create it with their own settings;
-routers stay thin and receive what they need through dependencies.
+:func:`create_app` builds the server's whole state (``ServerState``) from its ``Settings``, so tests and the CLI
+create apps with their own; routers stay thin and reach the state through ``api.deps``.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from collections.abc import AsyncIterator
+from contextlib import asynccontextmanager
 from pathlib import Path
 
 from fastapi import FastAPI
 from fastapi.responses import FileResponse, HTMLResponse
 from fastapi.staticfiles import StaticFiles
+from starlette.middleware import Middleware
 
 from servostudio import __version__
-from servostudio.api.deps import install_communication
+from servostudio.api.errors import EXCEPTION_HANDLERS, RequestIds, error_responses
 from servostudio.api.routes import backup, buses, dictionaries, drives, events, health, projects, users
-from servostudio.api.routes.errors import register_error_handlers
-from servostudio.od import BUILTIN_EDS_DIR, EdsLibrary
-from servostudio.od.library import DEFAULT_USER_EDS_DIR
+from servostudio.api.state import ServerState
+from servostudio.errors import ErrorKind
+from servostudio.services.settings import Settings
 
-STATIC_DIR = Path(__file__).resolve().parent.parent / "static"
-
-
-@dataclass
-class Settings:
-    """What the server was started with."""
-
-    projects_dir: Path = field(default_factory=lambda: Path("projects"))
-    static_dir: Path = STATIC_DIR
-    user_eds_dir: Path = DEFAULT_USER_EDS_DIR
-    buses: list[str] = field(default_factory=list)  # bus specs opened at startup
+__all__ = ["Settings", "create_app"]
 
 
 def create_app(settings: Settings | None = None) -> FastAPI:
-    settings = settings or Settings()
+    state = ServerState.build(settings or Settings())
     app = FastAPI(
         title="Servo Studio",
         version=__version__,
         description="Communication server of Servo Studio: buses, drives, parameters, projects.",
+        lifespan=_lifespan,
+        exception_handlers=EXCEPTION_HANDLERS,
+        middleware=[Middleware(RequestIds)],
+        responses=error_responses(ErrorKind.INVALID_INPUT, ErrorKind.INTERNAL),
     )
-    app.state.settings = settings
-    app.state.eds_library = EdsLibrary(BUILTIN_EDS_DIR, settings.user_eds_dir)
-    app.include_router(health.router, prefix="/api")
-    app.include_router(users.router, prefix="/api")
-    app.include_router(dictionaries.router, prefix="/api")
-    app.include_router(projects.router, prefix="/api")
-    install_communication(app, settings.buses)
-    register_error_handlers(app)
-    for router in (buses.router, drives.router, backup.router, events.router):
-        app.include_router(router, prefix="/api")
-    _mount_ui(app, settings.static_dir)
+    app.state.server = state
+    for router in (health, users, dictionaries, projects, buses, drives, backup, events):
+        app.include_router(router.router, prefix="/api")
+    _mount_ui(app, state.settings.static_dir)
     return app
+
+
+@asynccontextmanager
+async def _lifespan(app: FastAPI) -> AsyncIterator[None]:
+    """Open the buses the server was started with; close every bus at shutdown."""
+    state: ServerState = app.state.server
+    state.open_buses()
+    yield
+    state.close()
 
 
 def _mount_ui(app: FastAPI, static_dir: Path) -> None:

@@ -1,4 +1,5 @@
-"""Dependencies shared by the routers: the caller's identity and the communication server's state.
+"""Dependencies of the routes, one ``Annotated`` alias each: the caller, the server's state and its parts, and the
+bus and drive a path names.
 
 ``current_user`` is the one place a caller's identity comes from; every router and WebSocket depends on it, so
 user levels (the manual's password-protected levels) plug in here later without touching the routes.  The
@@ -7,16 +8,19 @@ server binds to localhost only, so today every caller is the local administrator
 
 from __future__ import annotations
 
-from collections.abc import AsyncIterator
-from contextlib import asynccontextmanager
 from dataclasses import dataclass
+from typing import Annotated
 
-from fastapi import FastAPI
+from fastapi import Depends, Header, Query
 from starlette.requests import HTTPConnection
 
+from servostudio.api.state import ServerState
+from servostudio.drive.access import Drive
 from servostudio.od import EdsLibrary
-from servostudio.services.bus import ConnectionManager, EventHub, JobRegistry
+from servostudio.services.bus import BusConnection, ConnectionManager, EventHub, JobRegistry
 from servostudio.services.motion import MotionGuard
+from servostudio.services.projects import ProjectService
+from servostudio.services.projects.live import LiveProjects
 
 
 @dataclass(frozen=True)
@@ -33,41 +37,76 @@ def current_user(connection: HTTPConnection) -> User:
     return LOCAL_ADMINISTRATOR
 
 
-def eds_library(connection: HTTPConnection) -> EdsLibrary:
-    """The dictionary library of this server (built-in `eds/` plus the user directory)."""
-    return connection.app.state.eds_library
+def server_state(connection: HTTPConnection) -> ServerState:
+    state: ServerState = connection.app.state.server
+    return state
 
 
-def get_connections(connection: HTTPConnection) -> ConnectionManager:
-    return connection.app.state.connections
+Caller = Annotated[User, Depends(current_user)]
+Server = Annotated[ServerState, Depends(server_state)]
 
 
-def get_motion(connection: HTTPConnection) -> MotionGuard:
-    return connection.app.state.motion
+def library(state: Server) -> EdsLibrary:
+    return state.library
 
 
-def get_jobs(connection: HTTPConnection) -> JobRegistry:
-    return connection.app.state.jobs
+def connections(state: Server) -> ConnectionManager:
+    return state.connections
 
 
-def get_events(connection: HTTPConnection) -> EventHub:
-    return connection.app.state.connections.events
+def motion(state: Server) -> MotionGuard:
+    return state.motion
 
 
-def install_communication(app: FastAPI, buses: list[str]) -> None:
-    """Give the app its connection manager and jobs; open ``buses`` at startup, close everything at shutdown."""
-    manager = ConnectionManager(getattr(app.state, "eds_library", None))
-    app.state.connections = manager
-    app.state.motion = MotionGuard()
-    app.state.jobs = JobRegistry(manager.events)
-    previous = app.router.lifespan_context
+def jobs(state: Server) -> JobRegistry:
+    return state.jobs
 
-    @asynccontextmanager
-    async def lifespan(application: FastAPI) -> AsyncIterator[None]:
-        for spec in buses:
-            manager.open(spec, wait=0.0)
-        async with previous(application):
-            yield
-        manager.close_all()
 
-    app.router.lifespan_context = lifespan
+def events(state: Server) -> EventHub:
+    return state.events
+
+
+def projects(state: Server) -> ProjectService:
+    return state.projects
+
+
+Library = Annotated[EdsLibrary, Depends(library)]
+Connections = Annotated[ConnectionManager, Depends(connections)]
+Motion = Annotated[MotionGuard, Depends(motion)]
+Jobs = Annotated[JobRegistry, Depends(jobs)]
+Events = Annotated[EventHub, Depends(events)]
+Projects = Annotated[ProjectService, Depends(projects)]
+
+
+def live_projects(service: Projects, manager: Connections) -> LiveProjects:
+    """Projects with the server's buses: a project bus is opened on first use and shared with every client."""
+    return LiveProjects(service, manager)
+
+
+def bus_connection(bus: str, manager: Connections) -> BusConnection:
+    """The open bus the path names."""
+    return manager.get(bus)
+
+
+Live = Annotated[LiveProjects, Depends(live_projects)]
+OpenBus = Annotated[BusConnection, Depends(bus_connection)]
+#: ``?device=`` names the node's device instead of identifying it on first use (and overrides the identified one).
+DeviceKey = Annotated[
+    str | None,
+    Query(
+        description="device key (xtrapulspac, cd1k, …) overriding the identified one; "
+        "by default the node is identified on first use",
+    ),
+]
+
+
+def node_drive(node: int, connection: OpenBus, device: DeviceKey = None) -> Drive:
+    """The drive the path's bus and node name."""
+    return connection.drive(node, device)
+
+
+NodeDrive = Annotated[Drive, Depends(node_drive)]
+#: The caller's live motion client (announced by /api/ws/events); required for anything that enables the drive.
+MotionClient = Annotated[
+    str | None, Header(alias="X-Servo-Client", description="id announced by /api/ws/events; required to enable")
+]

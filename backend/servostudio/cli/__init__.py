@@ -13,9 +13,14 @@ import sys
 from pathlib import Path
 
 from servostudio.cli import drive, eds, project
-from servostudio.cli.output import EXIT_USAGE, CommandError
-from servostudio.od.library import DEFAULT_USER_EDS_DIR
-from servostudio.sim import cli as sim_cli
+from servostudio.cli import sim as sim_cli
+from servostudio.cli.output import crashed, refused
+from servostudio.errors import RefusedForSafety, ServoStudioError
+from servostudio.services.settings import DEFAULT_HOST, DEFAULT_PORT, Settings
+
+
+class RemoteBindRefused(RefusedForSafety):
+    """A non-loopback address without --allow-remote: there is no login yet, so the server stays on this machine."""
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -31,15 +36,22 @@ def build_parser() -> argparse.ArgumentParser:
 
 def _add_serve(commands: argparse._SubParsersAction) -> None:
     serve = commands.add_parser("serve", help="start the communication server and the browser UI")
-    serve.add_argument("--host", default="127.0.0.1", help="address to bind (default: 127.0.0.1)")
-    serve.add_argument("--port", type=int, default=8000, help="TCP port (default: 8000)")
+    serve.add_argument("--host", default=DEFAULT_HOST, help=f"address to bind (default: {DEFAULT_HOST})")
+    serve.add_argument("--port", type=int, default=DEFAULT_PORT, help=f"TCP port (default: {DEFAULT_PORT})")
     serve.add_argument("--projects", type=Path, default=Path("projects"), help="project store directory")
     serve.add_argument(
         "--user-eds",
         type=Path,
-        default=DEFAULT_USER_EDS_DIR,
         metavar="DIR",
-        help=f"directory of imported EDS files (default: {DEFAULT_USER_EDS_DIR})",
+        help="directory of imported EDS files (default: $SERVOSTUDIO_USER_EDS_DIR, else "
+        "$XDG_DATA_HOME/servostudio/eds)",
+    )
+    serve.add_argument(
+        "--ui",
+        type=Path,
+        metavar="DIR",
+        help="serve the browser UI built in DIR (default: the package's own build; a `vite build --outDir` of "
+        "another version, to compare two UIs side by side)",
     )
     serve.add_argument(
         "--allow-remote",
@@ -63,32 +75,40 @@ def check_bind_host(host: str, allow_remote: bool) -> None:
     except ValueError:
         local = False
     if not (local or allow_remote):
-        raise CommandError(
+        raise RemoteBindRefused(
             f"--host {host}: the server binds to localhost only (127.0.0.1, ::1); "
-            "pass --allow-remote to accept connections from other machines",
-            EXIT_USAGE,
+            "pass --allow-remote to accept connections from other machines"
         )
 
 
 def _serve(args: argparse.Namespace) -> int:
     import uvicorn
 
-    from servostudio.api.app import Settings, create_app
+    from servostudio.api.app import create_app
 
     check_bind_host(args.host, args.allow_remote)
-    app = create_app(Settings(projects_dir=args.projects, user_eds_dir=args.user_eds, buses=args.bus or ["sim"]))
-    uvicorn.run(app, host=args.host, port=args.port, log_level="info")
+    settings = Settings.given(
+        projects_dir=args.projects,
+        user_eds_dir=args.user_eds,
+        static_dir=args.ui,
+        buses=tuple(args.bus or ["sim"]),
+        host=args.host,
+        port=args.port,
+    )
+    uvicorn.run(create_app(settings), host=settings.host, port=settings.port, log_level="info")
     return 0
 
 
 def main(argv: list[str] | None = None) -> int:
+    """Run one command; a refusal exits with the code of its kind, anything else is reported as a bug (70)."""
     args = build_parser().parse_args(argv)
     try:
         return args.handler(args)
-    except CommandError as error:
-        print(f"error: {error}", file=sys.stderr)
-        return error.exit_code
+    except ServoStudioError as error:
+        return refused(error)
     except BrokenPipeError:
         # The reader of our JSON went away (e.g. `| head`): not an error of the command itself.
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         return 0
+    except Exception as error:  # noqa: BLE001 - a bug: reported as such, with its traceback
+        return crashed(error)

@@ -1,7 +1,8 @@
 """Drive commands: ``servostudio scan|read|write|backup|restore|nmt|fault|state --bus SPEC [--node N] …``.
 
-Each command opens the bus, does its work, prints JSON on stdout and exits with a code that says what went wrong
-(see ``servostudio.cli.output``): 3 invalid input (nothing written), 4 unknown node/object, 5 communication.
+Each command opens the bus, does its work, prints JSON on stdout and exits with the code of what went wrong
+(the kind of the error, see ``servostudio.cli.output``): 3 refused (nothing written), 4 unknown node/object,
+5 communication.
 """
 
 from __future__ import annotations
@@ -10,35 +11,26 @@ import argparse
 import signal
 import sys
 import threading
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from pathlib import Path
 
-from servostudio.cli.output import (
-    EXIT_COMMUNICATION,
-    EXIT_INVALID_INPUT,
-    EXIT_NOT_FOUND,
-    CommandError,
-    emit,
-)
-from servostudio.drive.access import Drive, DriveAccessError, UnknownObjectError
+from servostudio.cli.output import emit
+from servostudio.drive.access import Drive
 from servostudio.drive.cia402 import State
-from servostudio.drive.control import StateChangeError, fault_report, read_state, reset_faults, set_state
+from servostudio.drive.control import fault_report, read_state, reset_faults, set_state
 from servostudio.drive.link import LinkDownError
-from servostudio.drive.nmt import NmtCommand, send_nmt
-from servostudio.drive.profiles import ProfileError
-from servostudio.drive.sdo import SdoError
 from servostudio.services.backup import (
     BackupError,
-    RestoreValidationError,
+    RestoreResult,
     backup_drive,
     backup_file,
-    drive_file_kinds,
+    restore_drive,
     restore_file,
     run_per_drive,
 )
-from servostudio.services.bus import BusConnection, ConnectionManager, UnknownBusOrNode
-from servostudio.services.scan import identify, scan
-from servostudio.transport.spec import BusSpecError
+from servostudio.services.bus import BusConnection, ConnectionManager
+from servostudio.services.scan import NoAnswer, identified, scan
+from servostudio.services.transfers import FileResult, per_node
 
 CONNECT_WAIT = 3.0
 
@@ -101,37 +93,23 @@ def register(commands: argparse._SubParsersAction) -> None:
 
 
 def _run(args: argparse.Namespace, handler: Callable[[argparse.Namespace, BusConnection], object]) -> int:
+    """Open the bus, run the command on it, close it; errors go to ``main``, which exits with their kind's code."""
     manager = ConnectionManager()
     try:
         connection = manager.open(args.bus, wait=CONNECT_WAIT)
         if not connection.link.connected:
-            raise CommandError(
-                f"bus {args.bus}: not connected ({connection.link.last_error or 'no answer'})", EXIT_COMMUNICATION
-            )
+            raise LinkDownError(f"bus {args.bus}: not connected ({connection.link.last_error or 'no answer'})")
         return emit(handler(args, connection))
-    except (UnknownBusOrNode, ProfileError, UnknownObjectError) as error:
-        raise CommandError(str(error), EXIT_NOT_FOUND) from None
-    except (RestoreValidationError, DriveAccessError, BusSpecError, ValueError) as error:
-        raise CommandError(str(error), EXIT_INVALID_INPUT) from None
-    except (SdoError, BackupError, LinkDownError, StateChangeError) as error:
-        raise CommandError(str(error), EXIT_COMMUNICATION) from None
     finally:
         manager.close_all()
 
 
 def _drive(args: argparse.Namespace, connection: BusConnection, node: int | None = None) -> Drive:
+    """The node's drive; a node named without ``--device`` must answer and be a device of the library."""
     node = node if node is not None else args.node
     device = getattr(args, "device", None)
     if device is None:
-        info = identify(connection, node)
-        if info is None:
-            raise CommandError(f"node {node} does not answer on {connection.spec}", EXIT_COMMUNICATION)
-        if info.device is None:
-            raise CommandError(
-                f"node {node} (vendor 0x{info.vendor_id or 0:X}, product 0x{info.product_code or 0:X}) "
-                "matches no dictionary of the EDS library; give --device",
-                EXIT_NOT_FOUND,
-            )
+        identified(connection, node)
     return connection.drive(node, device)
 
 
@@ -140,7 +118,7 @@ def _nodes(args: argparse.Namespace, connection: BusConnection) -> list[Drive]:
         return [_drive(args, connection, node) for node in args.node]
     found = scan(connection)
     if not found:
-        raise CommandError(f"no node answers on {connection.spec}", EXIT_COMMUNICATION)
+        raise NoAnswer(f"no node answers on {connection.spec}")
     return [connection.drive(info.node) for info in found if info.device]
 
 
@@ -163,55 +141,42 @@ def _backup(args: argparse.Namespace, connection: BusConnection) -> object:
     out: Path = args.out
     if len(drives) == 1 and not out.is_dir() and out.suffix:
         return backup_file(drives[0], out).as_dict()
-    results = run_per_drive(drives, lambda drive: backup_drive(drive, out / f"node{drive.node}"))
-    return _collect(results, lambda items: [item.as_dict() for item in items])
+    return _collect(run_per_drive(drives, lambda drive: backup_drive(drive, out / f"node{drive.node}")))
 
 
 def _restore(args: argparse.Namespace, connection: BusConnection) -> object:
     drives = _nodes(args, connection)
     source: Path = args.source
+    store = not args.no_store
     if len(drives) == 1 and source.is_file():
-        result = restore_file(drives[0], source, store=not args.no_store)
+        result = restore_file(drives[0], source, store=store)
         if not result.ok:
             emit(result.as_dict())
             raise BackupError(_restore_failure(result.as_dict()))
         return result.as_dict()
-
-    def restore_all(drive: Drive) -> list:
-        folder = source / f"node{drive.node}"
-        kinds = [kind for kind in drive_file_kinds(drive) if (folder / kind.value).is_file()]
-        if not kinds:
-            raise RestoreValidationError(
-                f"{folder}: no DRIVEPAR.TXT, USER_PAR.TXT or SEQUENCE.TXT for node {drive.node}"
-            )
-        return [restore_file(drive, folder / kind.value, kind, store=not args.no_store) for kind in kinds]
-
-    results = run_per_drive(drives, restore_all)
     return _collect(
-        results,
-        lambda items: [item.as_dict() for item in items],
-        failed=lambda items: any(not item.ok for item in items),
+        run_per_drive(drives, lambda drive: restore_drive(drive, source / f"node{drive.node}", store=store))
     )
 
 
-def _collect(
-    results: dict[int, object], show: Callable[[object], object], failed: Callable[[object], bool] = lambda _: False
-) -> object:
+def _collect(results: dict[int, Sequence[FileResult] | Exception]) -> object:
     """Per-node results; the first failure decides the exit code after everything was tried."""
-    shown: dict[str, object] = {}
-    errors = []
-    for node, outcome in results.items():
-        if isinstance(outcome, Exception):
-            shown[str(node)] = {"error": str(outcome)}
-            errors.append(outcome)
-        else:
-            shown[str(node)] = show(outcome)
-            if failed(outcome):
-                errors.append(BackupError(f"node {node}: restore incomplete"))
-    if errors:
+    shown = per_node(results)
+    errors = [_failure(node, outcome) for node, outcome in results.items()]
+    first = next((error for error in errors if error is not None), None)
+    if first is not None:
         emit(shown)
-        raise errors[0]
+        raise first
     return shown
+
+
+def _failure(node: int, outcome: Sequence[FileResult] | Exception) -> Exception | None:
+    """What failed on a node: its exception, or an incomplete restore."""
+    if isinstance(outcome, Exception):
+        return outcome
+    if any(isinstance(item, RestoreResult) and not item.ok for item in outcome):
+        return BackupError(f"node {node}: restore incomplete")
+    return None
 
 
 def _restore_failure(result: dict) -> str:
@@ -221,8 +186,7 @@ def _restore_failure(result: dict) -> str:
 
 
 def _nmt(args: argparse.Namespace, connection: BusConnection) -> object:
-    command = NmtCommand.parse(args.command_name)
-    send_nmt(connection.link, command, args.node)
+    command = connection.nmt(args.command_name, args.node)
     return {"command": command.name.lower().replace("_", "-"), "node": args.node}
 
 

@@ -5,14 +5,19 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from servostudio.cli.output import EXIT_INVALID_INPUT, EXIT_NOT_FOUND, CommandError, emit
-from servostudio.od import BUILTIN_EDS_DIR, DictionaryError, EdsLibrary, LibraryError, load_dictionary
-from servostudio.od.library import DEFAULT_USER_EDS_DIR
+from servostudio.cli.output import emit
+from servostudio.od import EdsLibrary
+from servostudio.services import dictionaries
+from servostudio.services.settings import Settings
 
 
 def register(commands: argparse._SubParsersAction) -> None:
     eds = commands.add_parser("eds", help="object dictionaries (EDS library)")
-    eds.add_argument("--user-dir", type=Path, default=DEFAULT_USER_EDS_DIR, help="user EDS library directory")
+    eds.add_argument(
+        "--user-dir",
+        type=Path,
+        help="user EDS library directory (default: $SERVOSTUDIO_USER_EDS_DIR, else the user's data)",
+    )
     actions = eds.add_subparsers(dest="action", required=True)
 
     actions.add_parser("list", help="devices of the library").set_defaults(handler=_list)
@@ -34,7 +39,8 @@ def register(commands: argparse._SubParsersAction) -> None:
 
 
 def _library(args: argparse.Namespace) -> EdsLibrary:
-    return EdsLibrary(BUILTIN_EDS_DIR, args.user_dir)
+    settings = Settings.given(user_eds_dir=args.user_dir)
+    return EdsLibrary(settings.builtin_eds_dir, settings.user_eds_dir)
 
 
 def _describe(od) -> dict:
@@ -74,29 +80,17 @@ def _list(args: argparse.Namespace) -> int:
 
 
 def _show(args: argparse.Namespace) -> int:
-    try:
-        od = _library(args).load(args.device)
-    except LibraryError as error:
-        raise CommandError(str(error), EXIT_NOT_FOUND) from error
+    od = dictionaries.dictionary(_library(args), args.device)
     if args.object is None:
         return emit({**_describe(od), "entries": [_entry(var) for var in od.variables()]})
-    try:
-        return emit(_entry(od.find(args.object)))
-    except KeyError as error:
-        raise CommandError(error.args[0], EXIT_NOT_FOUND) from error
+    return emit(_entry(dictionaries.entry(od, args.object)))
 
 
 def _check(args: argparse.Namespace) -> int:
-    try:
-        return emit(_describe(load_dictionary(args.eds, args.props)))
-    except (DictionaryError, OSError) as error:
-        raise CommandError(str(error), EXIT_INVALID_INPUT) from error
+    return emit(_describe(dictionaries.check_file(args.eds, args.props)))
 
 
 def _import(args: argparse.Namespace) -> int:
     library = _library(args)
-    try:
-        device = library.import_eds(args.eds, args.props)
-    except (DictionaryError, LibraryError, OSError) as error:
-        raise CommandError(str(error), EXIT_INVALID_INPUT) from error
+    device = dictionaries.import_file(library, args.eds, args.props)
     return emit(_describe(library.load(device)))

@@ -1,8 +1,8 @@
 """`servostudio project …`: the project store from the command line (same service as the REST API).
 
-Exit codes: 0 done; 3 refused (bad value, rule broken, conflicting change, unsafe archive, a drive that is not the
-axis's device; nothing written); 4 not found (project, axis, object, motor, template); 5 communication (bus not
-connected, drive not answering or refusing).
+Exit codes (the kind of the error, ``servostudio.errors``): 0 done; 3 refused (bad value, rule broken, conflicting
+change, unsafe archive, a drive that is not the axis's device; nothing written); 4 not found (project, axis, object,
+motor, template); 5 communication (bus not connected, drive not answering, values the drive refused).
 """
 
 from __future__ import annotations
@@ -11,15 +11,11 @@ import argparse
 import functools
 from pathlib import Path
 
-from servostudio.cli.output import EXIT_COMMUNICATION, EXIT_INVALID_INPUT, EXIT_NOT_FOUND, CommandError, emit
-from servostudio.drive.link import LinkDownError
-from servostudio.drive.sdo import SdoError
-from servostudio.od import BUILTIN_EDS_DIR, EdsLibrary
-from servostudio.od.library import DEFAULT_USER_EDS_DIR
-from servostudio.services.backup import BackupError
+from servostudio.cli.output import emit
+from servostudio.errors import CommunicationError, InvalidInput, NotFound
+from servostudio.od import EdsLibrary
 from servostudio.services.bus import ConnectionManager
-from servostudio.services.projects import Axis, Bus, ProjectError, ProjectNotFound, ProjectService
-from servostudio.services.projects.errors import DriveUnavailable
+from servostudio.services.projects import Axis, Bus, DriveMismatch, ProjectService
 from servostudio.services.projects.fsutil import atomic_write
 from servostudio.services.projects.jsonview import (
     choice_view,
@@ -33,13 +29,15 @@ from servostudio.services.projects.jsonview import (
 from servostudio.services.projects.live import LiveProjects
 from servostudio.services.projects.motors import motor_from_text
 from servostudio.services.projects.templates import templates_for
-from servostudio.transport.spec import BusSpecError
+from servostudio.services.settings import Settings
 
 
 def register(commands: argparse._SubParsersAction) -> None:
     project = commands.add_parser("project", help="projects, axes and offline parameters")
     project.add_argument("--projects", type=Path, default=Path("projects"), help="project store directory")
-    project.add_argument("--user-eds-dir", type=Path, default=DEFAULT_USER_EDS_DIR, help="user EDS library")
+    project.add_argument(
+        "--user-eds-dir", type=Path, help="user EDS library (default: $SERVOSTUDIO_USER_EDS_DIR, else the user's data)"
+    )
     actions = project.add_subparsers(dest="action", required=True)
 
     def action(name: str, handler, summary: str) -> argparse.ArgumentParser:
@@ -209,31 +207,25 @@ def register(commands: argparse._SubParsersAction) -> None:
 
 
 @functools.cache
-def _library(user_eds_dir: Path) -> EdsLibrary:
-    """One library per user directory, so a process running several commands parses each EDS once."""
-    return EdsLibrary(BUILTIN_EDS_DIR, user_eds_dir)
+def _library(builtin_dir: Path, user_dir: Path) -> EdsLibrary:
+    """One library per directory pair, so a process running several commands parses each EDS once."""
+    return EdsLibrary(builtin_dir, user_dir)
 
 
 def _run(handler, args: argparse.Namespace) -> int:
-    service = ProjectService(args.projects, _library(args.user_eds_dir))
+    """Run an action on the store; errors go to ``main``, which exits with their kind's code."""
+    settings = Settings.given(projects_dir=args.projects, user_eds_dir=args.user_eds_dir)
+    library = _library(settings.builtin_eds_dir, settings.user_eds_dir)
+    service = ProjectService(settings.projects_dir, library, settings.motors_dir)
+    args.connections = ConnectionManager(library)  # live actions open buses in it; none is opened otherwise
     try:
         return emit(handler(service, args))
-    except ProjectNotFound as error:
-        raise CommandError(str(error), EXIT_NOT_FOUND) from None
-    except (DriveUnavailable, SdoError, LinkDownError, BackupError) as error:
-        raise CommandError(str(error), EXIT_COMMUNICATION) from None
-    except (ProjectError, BusSpecError) as error:
-        raise CommandError(str(error), EXIT_INVALID_INPUT) from None
     finally:
-        manager = getattr(args, "connections", None)
-        if manager is not None:
-            manager.close_all()
+        args.connections.close_all()
 
 
 def _live(service: ProjectService, args: argparse.Namespace) -> LiveProjects:
     """Live commands open the buses they need; ``_run`` closes them when the command ends."""
-    if getattr(args, "connections", None) is None:
-        args.connections = ConnectionManager(service.library)
     return LiveProjects(service, args.connections)
 
 
@@ -242,7 +234,7 @@ def _via(args: argparse.Namespace) -> dict[str, str]:
     for text in getattr(args, "via", []):
         bus, equals, spec = text.partition("=")
         if not equals or not bus or not spec:
-            raise CommandError(f"--via {text!r}: expected BUS=SPEC", EXIT_INVALID_INPUT)
+            raise InvalidInput(f"--via {text!r}: expected BUS=SPEC")
         routes[bus] = spec
     return routes
 
@@ -259,7 +251,7 @@ def _bus(text: str) -> Bus:
     name, equals, rest = text.partition("=")
     interface, at, bitrate = rest.partition("@")
     if not equals or not interface or (at and not bitrate.isdigit()):
-        raise CommandError(f"--bus {text!r}: expected NAME=INTERFACE or NAME=INTERFACE@BITRATE", EXIT_INVALID_INPUT)
+        raise InvalidInput(f"--bus {text!r}: expected NAME=INTERFACE or NAME=INTERFACE@BITRATE")
     return Bus(name, interface, int(bitrate) if at else None)
 
 
@@ -309,7 +301,7 @@ def _set(service: ProjectService, args: argparse.Namespace) -> dict:
     for text in args.assignments:
         address, equals, value = text.partition("=")
         if not equals:
-            raise CommandError(f"{text!r}: expected ADDRESS=VALUE", EXIT_INVALID_INPUT)
+            raise InvalidInput(f"{text!r}: expected ADDRESS=VALUE")
         changes[address] = value
     change = service.parameters.set(args.name, args.axis, changes, args.revision)
     return {"parameters": [parameter_view(row) for row in change.rows], "revision": change.revision}
@@ -363,7 +355,7 @@ def _write(service: ProjectService, args: argparse.Namespace) -> dict:
     report = _live(service, args).write(args.name, args.axis, args.addresses or None, args.store, _via(args))
     if not report.ok:
         emit(report.as_dict())
-        raise CommandError(f"axis '{args.axis}': the drive refused some values (see the report)", EXIT_COMMUNICATION)
+        raise CommunicationError(f"axis '{args.axis}': the drive refused some values (see the report)")
     return report.as_dict()
 
 
@@ -375,10 +367,8 @@ def _commission(service: ProjectService, args: argparse.Namespace) -> dict:
     failed = [axis for axis in report.axes if not axis.ok]
     only_mismatch = all(axis.link.status == "wrong_device" for axis in failed)
     names = ", ".join(axis.link.axis.name for axis in failed)
-    raise CommandError(
-        f"project '{args.name}': axes {names} not commissioned (see the report)",
-        EXIT_INVALID_INPUT if only_mismatch else EXIT_COMMUNICATION,
-    )
+    message = f"project '{args.name}': axes {names} not commissioned (see the report)"
+    raise DriveMismatch(message) if only_mismatch else CommunicationError(message)
 
 
 def _scan(service: ProjectService, args: argparse.Namespace) -> dict:
@@ -413,7 +403,7 @@ def _motor_add(service: ProjectService, args: argparse.Namespace) -> dict:
     try:
         text = args.file.read_text(encoding="utf-8")
     except OSError as error:
-        raise CommandError(f"{args.file}: {error.strerror}", EXIT_NOT_FOUND) from None
+        raise NotFound(f"{args.file}: {error.strerror}") from None
     return motor_view(service.motors.add(motor_from_text(text, args.file)))
 
 

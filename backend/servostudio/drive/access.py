@@ -16,20 +16,20 @@ from concurrent.futures import Future
 
 from servostudio.drive.object_values import ObjectValue, Raw, decode_raw, parse_input
 from servostudio.drive.profiles import DeviceProfile, profile_for
-from servostudio.drive.sdo import SdoEngine, TransferBatch
+from servostudio.drive.sdo import SAFETY_WAIT, SdoEngine, TransferBatch, settle
+from servostudio.errors import InvalidInput, NotFound
 from servostudio.od.datatypes import DataType, encode
 from servostudio.od.model import Access, ObjectDictionary, Variable
 
-#: Safety net only: the engine completes every transfer (answer, abort, timeout or link loss), but a transfer
-#: may wait behind many queued ones of the same node.
-DEFAULT_WAIT = 120.0
+#: Safety net only (`servostudio.drive.sdo.SAFETY_WAIT`): the engine completes every transfer itself.
+DEFAULT_WAIT = SAFETY_WAIT
 
 
-class DriveAccessError(ValueError):
+class DriveAccessError(InvalidInput):
     """A read or write refused before anything was sent (unknown object, access, value)."""
 
 
-class UnknownObjectError(DriveAccessError, LookupError):
+class UnknownObjectError(NotFound, DriveAccessError):
     """The object is not in the drive's dictionary (or no dictionary is known for the drive)."""
 
 
@@ -68,8 +68,9 @@ class Drive:
             ) from None
 
     # -- reads ---------------------------------------------------------------------------------------------------
-    def submit_read(self, variable: Variable, timeout: float | None = None) -> Future:
-        """Queue a read; the future gives an ObjectValue."""
+    def submit_read(self, variable: Variable, timeout: float | None = None, bulk: bool = False) -> Future:
+        """Queue a read; the future gives an ObjectValue (``bulk``: part of a long operation, served after the
+        interactive requests of the node)."""
         if not variable.access.readable:
             raise DriveAccessError(f"node {self.node}: {variable.label} is write-only")
         return self.engine.upload(
@@ -78,11 +79,12 @@ class Drive:
             variable.subindex,
             timeout,
             convert=lambda data: ObjectValue(self.node, variable, decode_raw(variable, data)),
+            bulk=bulk,
         )
 
     def submit_read_all(
         self, variables: Sequence[Variable], on_each: Callable[[int, ObjectValue | Exception], None] | None = None
-    ) -> TransferBatch:
+    ) -> TransferBatch[ObjectValue]:
         """Queue reads of many objects at once; the batch's future gives, in order, an ObjectValue or the exception
         that ended each read (see `TransferBatch`)."""
         for variable in variables:
@@ -99,7 +101,7 @@ class Drive:
 
     def read(self, key: str | tuple[int, int] | Variable, timeout: float | None = None) -> ObjectValue:
         variable = key if isinstance(key, Variable) else self.variable(key)
-        return self.submit_read(variable, timeout).result(DEFAULT_WAIT + (timeout or 0))
+        return settle(self.submit_read(variable, timeout), DEFAULT_WAIT + (timeout or 0))
 
     # -- writes --------------------------------------------------------------------------------------------------
     def prepare_write(
@@ -121,9 +123,14 @@ class Drive:
         return variable, raw, data
 
     def submit_write(
-        self, key: str | tuple[int, int] | Variable, value: object, physical: bool = False, timeout: float | None = None
+        self,
+        key: str | tuple[int, int] | Variable,
+        value: object,
+        physical: bool = False,
+        timeout: float | None = None,
+        bulk: bool = False,
     ) -> Future:
-        """Check, then queue a write; the future gives the ObjectValue written."""
+        """Check, then queue a write; the future gives the ObjectValue written (``bulk`` as for `submit_read`)."""
         variable, raw, data = self.prepare_write(key, value, physical)
         return self.engine.download(
             self.node,
@@ -132,13 +139,14 @@ class Drive:
             data,
             timeout,
             convert=lambda _: ObjectValue(self.node, variable, raw),
+            bulk=bulk,
         )
 
     def submit_write_all(
         self,
         writes: Sequence[tuple[Variable, object]],
         on_each: Callable[[int, ObjectValue | Exception], None] | None = None,
-    ) -> TransferBatch:
+    ) -> TransferBatch[ObjectValue]:
         """Check every write, then queue them all (nothing is sent if one fails its check); the batch's future
         gives, in order, the ObjectValue written or the exception that ended each write (see `TransferBatch`)."""
         prepared = [self.prepare_write(variable, value) for variable, value in writes]
@@ -152,11 +160,11 @@ class Drive:
     def write(
         self, key: str | tuple[int, int] | Variable, value: object, physical: bool = False, timeout: float | None = None
     ) -> ObjectValue:
-        return self.submit_write(key, value, physical, timeout).result(DEFAULT_WAIT + (timeout or 0))
+        return settle(self.submit_write(key, value, physical, timeout), DEFAULT_WAIT + (timeout or 0))
 
     def write_raw_bytes(self, index: int, sub: int, data: bytes, timeout: float | None = None) -> None:
         """Write bytes to an object the dictionary may not know (procedure signatures on unknown devices)."""
-        self.engine.download(self.node, index, sub, data, timeout).result(DEFAULT_WAIT + (timeout or 0))
+        settle(self.engine.download(self.node, index, sub, data, timeout), DEFAULT_WAIT + (timeout or 0))
 
     def start_procedure(self, procedure: str, timeout: float = 10.0) -> None:
         """Write a procedure's signature (decisions.md §4), e.g. "save" → 0x1010,1 = 'save'."""

@@ -8,8 +8,10 @@ from __future__ import annotations
 
 import enum
 
+from servostudio.errors import InvalidInput
 
-class State(str, enum.Enum):
+
+class State(enum.StrEnum):
     NOT_READY_TO_SWITCH_ON = "NOT READY TO SWITCH ON"
     SWITCH_ON_DISABLED = "SWITCH ON DISABLED"
     READY_TO_SWITCH_ON = "READY TO SWITCH ON"
@@ -32,7 +34,7 @@ class State(str, enum.Enum):
         for state in cls:
             if state.value == key:
                 return state
-        raise ValueError(
+        raise InvalidInput(
             f"unknown CiA 402 state {text!r}; use one of: "
             + ", ".join(state.value.lower().replace(" ", "-") for state in cls)
         )
@@ -108,7 +110,7 @@ def next_command(current: State, target: State) -> Command | None:
     if current is State.QUICK_STOP_ACTIVE:
         return Command.DISABLE_VOLTAGE
     if target not in _ORDER or current not in _ORDER:
-        raise ValueError(f"no command leads from {current.value} to {target.value}")
+        raise InvalidInput(f"no command leads from {current.value} to {target.value}")
     if _ORDER.index(target) > _ORDER.index(current):
         return _UP[current]
     return _DOWN[current]

@@ -8,12 +8,13 @@ from dataclasses import dataclass, field
 from servostudio.drive.access import Drive
 from servostudio.drive.cia402 import Command, State, apply_command, decode_state, next_command
 from servostudio.drive.faults import FaultInfo, cia402_error_text, faults_from_words
+from servostudio.errors import Conflict
 
 STEP_TIMEOUT = 1.0
 POLL_PERIOD = 0.01
 
 
-class StateChangeError(RuntimeError):
+class StateChangeError(Conflict, RuntimeError):
     """The drive did not reach the requested state; names node, state reached and status word."""
 
 

@@ -14,12 +14,15 @@ futures, converting values) never delays a request.
 
 from __future__ import annotations
 
+import contextlib
 import logging
 import threading
 import time
 from collections.abc import Callable
 
 import can
+
+from servostudio.errors import Unavailable
 
 log = logging.getLogger(__name__)
 
@@ -30,7 +33,7 @@ TICK_INTERVAL = 0.01
 POLL_INTERVAL = 0.02
 
 
-class LinkDownError(ConnectionError):
+class LinkDownError(Unavailable, ConnectionError):
     """The bus is not connected (never opened, lost, or closed)."""
 
 
@@ -67,10 +70,18 @@ class BusLink:
         return self.connected
 
     def close(self) -> None:
+        """Stop the reader and close the interface, then tell the listeners the link is down: the transfers waiting
+        on it fail at once (no reader thread is left to answer or time them out)."""
         self._stop.set()
         if self._thread is not None and self._thread is not threading.current_thread():
             self._thread.join(timeout=2.0)
         self._drop_bus()
+        self.last_error = "closed"
+        self._notify(False, "closed")
+
+    @property
+    def closed(self) -> bool:
+        return self._stop.is_set()
 
     @property
     def connected(self) -> bool:
@@ -195,10 +206,8 @@ class BusLink:
         self._connected.clear()
         bus, self._bus = self._bus, None
         if bus is not None:
-            try:
+            with contextlib.suppress(can.CanError, OSError):
                 bus.shutdown()
-            except (can.CanError, OSError):
-                pass
         return was_connected
 
     def _dispatch(self, cob_id: int, data: bytes, timestamp: float) -> None:

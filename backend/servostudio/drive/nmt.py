@@ -5,6 +5,7 @@ from __future__ import annotations
 import enum
 
 from servostudio.drive.link import BusLink
+from servostudio.errors import InvalidInput
 
 
 class NmtCommand(enum.IntEnum):
@@ -29,7 +30,7 @@ class NmtCommand(enum.IntEnum):
             return cls[key.upper()]
         except KeyError:
             names = ", ".join(name.lower().replace("_", "-") for name in cls.__members__)
-            raise ValueError(f"unknown NMT command {text!r}; use one of {names}") from None
+            raise InvalidInput(f"unknown NMT command {text!r}; use one of {names}") from None
 
 
 #: NMT state byte of heartbeat / boot-up frames (0x700 + node)
@@ -38,5 +39,5 @@ NMT_STATES = {0x00: "INITIALISING", 0x04: "STOPPED", 0x05: "OPERATIONAL", 0x7F: 
 
 def send_nmt(link: BusLink, command: NmtCommand, node: int = 0) -> None:
     if not 0 <= node <= 127:
-        raise ValueError(f"node ID {node} outside 0..127 (0 = all nodes)")
+        raise InvalidInput(f"node ID {node} outside 0..127 (0 = all nodes)")
     link.send(0x000, bytes([int(command), node]))

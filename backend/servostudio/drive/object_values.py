@@ -8,13 +8,14 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from servostudio.errors import InvalidInput
 from servostudio.od.datatypes import DataType, EncodingError, decode
 from servostudio.od.model import OutOfRange, Variable, WrongType
 
 Raw = int | float | str | bytes
 
 
-class ValueInputError(ValueError):
+class ValueInputError(InvalidInput):
     """User input that cannot become a value of the object; the message names the object."""
 
 
@@ -103,9 +104,9 @@ class ObjectValue:
         """What a terminal shows: the enumeration label, else the physical value with its unit."""
         if isinstance(self.raw, int) and self.raw in self.variable.enum:
             return self.variable.enum[self.raw]
-        if isinstance(self.raw, bytes):
-            return self.raw.hex(" ")
-        value = self.physical
+        value = self.physical  # bytes stay bytes
+        if isinstance(value, bytes):
+            return value.hex(" ")
         return f"{value} {self.variable.unit}".strip() if self.variable.unit else str(value)
 
     def bits(self) -> list[dict[str, object]]:

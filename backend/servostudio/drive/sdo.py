@@ -10,6 +10,15 @@ the follow-up requests left (``BusLink.after_dispatch``).
 A read whose request got no answer at all is sent once more before it times out (reads have no side effect, and
 one lost frame should not fail a 400-object backup); writes are never repeated.
 
+Each node's queue has two lanes.  Bulk work — the batches of a backup, a restore or a commission, and the
+sequence transfers of a backup — waits in the bulk lane; a single read or write someone waits for (a REST call,
+the terminal, the status-word watch) goes to the interactive lane, which the node serves first.  A batch thus
+yields to interactive requests between its transfers: a read during ten backups waits for at most the one transfer
+on the wire, not for thousands queued before it.
+
+Every transfer ends by itself — answer, abort, timeout, link lost, bus closed — so a future never stays pending;
+waits on futures are still bounded (`settle`, `TransferBatch.outcomes`), as a safety net against a stuck reader.
+
 Block transfers are not used: the dictionaries' values fit in one expedited frame or a few segments, where a
 block transfer needs more frames than a segmented one.
 """
@@ -22,20 +31,30 @@ import time
 from collections import deque
 from collections.abc import Callable, Sequence
 from concurrent.futures import CancelledError, Future
+from typing import Any, Generic, TypeVar
 
 from servostudio.drive.abort_codes import abort_text
 from servostudio.drive.link import BusLink, LinkDownError
+from servostudio.errors import CommunicationError, Conflict, Timeout, Unavailable
 
 SDO_REQUEST = 0x600
 SDO_RESPONSE = 0x580
 DEFAULT_TIMEOUT = 0.5
+#: Safety net of every wait on a transfer: the engine ends each transfer itself, but a transfer may wait behind
+#: many queued ones of its node, and a stuck reader thread must not hang a request or a job for ever.
+SAFETY_WAIT = 120.0
 UPLOAD_RETRIES = 1  # a read has no side effect: one lost frame should not fail a 400-object backup
 ABORT_TIMEOUT = 0x05040000
 ABORT_COMMAND = 0x05040001
 ABORT_TOGGLE = 0x05030000
 
+#: What a transfer ends with before conversion: the bytes read, or None for a write. The transfer's direction
+#: decides which, so the completions (shared by both directions) take either; the public methods say which.
+_Result = Any
+R = TypeVar("R")
 
-class SdoError(Exception):
+
+class SdoError(CommunicationError):
     """An SDO transfer failed; the message names the node and the object."""
 
     def __init__(self, node: int, index: int, sub: int, reason: str) -> None:
@@ -46,7 +65,7 @@ class SdoError(Exception):
         self.reason = reason
 
 
-class SdoAbortError(SdoError):
+class SdoAbortError(Conflict, SdoError):
     """The drive refused the transfer with a CiA 301 abort code."""
 
     def __init__(self, node: int, index: int, sub: int, code: int) -> None:
@@ -54,12 +73,26 @@ class SdoAbortError(SdoError):
         self.code = code
 
 
-class SdoTimeoutError(SdoError):
+class SdoTimeoutError(Timeout, SdoError):
     """The drive did not answer in time (absent, unpowered, or the link is broken)."""
 
 
-class SdoLinkError(SdoError):
-    """The bus went down before or during the transfer."""
+class SdoLinkError(Unavailable, SdoError):
+    """The bus went down (or was closed) before or during the transfer."""
+
+
+class OutcomeOverdue(Timeout):
+    """A transfer's outcome did not arrive within the safety bound of the wait (the bus reader is stuck)."""
+
+
+def settle(future: Future[R], seconds: float = SAFETY_WAIT) -> R:
+    """The result of a transfer's future, waiting at most ``seconds``; the one bounded wait of the product."""
+    try:
+        return future.result(seconds)
+    except TimeoutError:
+        raise OutcomeOverdue(
+            f"no outcome of the transfer within {seconds:.0f} s; the bus reader may be stuck"
+        ) from None
 
 
 class _FutureCompletion:
@@ -67,8 +100,8 @@ class _FutureCompletion:
 
     __slots__ = ("convert", "future")
 
-    def __init__(self, convert: Callable[[object], object] | None) -> None:
-        self.future: Future = Future()
+    def __init__(self, convert: Callable[[_Result], object] | None) -> None:
+        self.future: Future[object] = Future()
         self.convert = convert
 
     def start(self, slot: int) -> bool:
@@ -77,13 +110,13 @@ class _FutureCompletion:
     def drive_silent(self) -> None:
         """Nothing more to drop: the transfer itself ends with its timeout."""
 
-    def done(self, slot: int, outcome: object) -> None:
+    def done(self, slot: int, outcome: _Result | Exception) -> None:
         if self.future.done():
             return
         if not isinstance(outcome, Exception) and self.convert is not None:
             try:
                 outcome = self.convert(outcome)
-            except Exception as error:  # ValueError: bytes that are no value; anything else reaches the caller too
+            except Exception as error:  # noqa: BLE001 -- the caller gets any error of convert (ValueError: no value)
                 outcome = error
         if isinstance(outcome, Exception):
             self.future.set_exception(outcome)
@@ -91,7 +124,7 @@ class _FutureCompletion:
             self.future.set_result(outcome)
 
 
-class TransferBatch:
+class TransferBatch(Generic[R]):
     """Reads (or writes) of many objects of one node with one future for all: ``future`` gives a list, in request
     order, of each result — the bytes read or None for a write, passed through ``convert(position, result)`` when
     given — or the exception that ended that transfer.
@@ -105,12 +138,13 @@ class TransferBatch:
     def __init__(
         self,
         count: int,
-        convert: Callable[[int, bytes], object] | None = None,
-        on_each: Callable[[int, object], None] | None = None,
+        convert: Callable[[int, _Result], R] | None = None,
+        on_each: Callable[[int, R | Exception], None] | None = None,
     ) -> None:
-        self.future: Future = Future()
+        self.future: Future[list[R | Exception]] = Future()
         self.future.set_running_or_notify_cancel()
-        self._outcomes: list[object] = [None] * count
+        self.patience = SAFETY_WAIT  # the engine adds the time its own transfers may take
+        self._outcomes: list[Any] = [None] * count  # every slot is filled before the future completes
         self._left = count
         self._convert = convert
         self._on_each = on_each
@@ -118,6 +152,10 @@ class TransferBatch:
         self._lock = threading.Lock()
         if count == 0:
             self.future.set_result([])
+
+    def outcomes(self) -> list[R | Exception]:
+        """Wait for every transfer of the batch (bounded by ``patience``) and give their outcomes."""
+        return settle(self.future, self.patience)
 
     def cancel(self) -> None:
         self._cancelled = True
@@ -129,11 +167,11 @@ class TransferBatch:
         """A transfer timed out: the drive stopped answering, the transfers still queued are dropped."""
         self._cancelled = True
 
-    def done(self, slot: int, outcome: object) -> None:
+    def done(self, slot: int, outcome: _Result | Exception) -> None:
         if not isinstance(outcome, Exception) and self._convert is not None:
             try:
                 outcome = self._convert(slot, outcome)
-            except Exception as error:  # ValueError: bytes that are no value; anything else reaches the caller too
+            except Exception as error:  # noqa: BLE001 -- the caller gets any error of convert (ValueError: no value)
                 outcome = error
         with self._lock:
             self._outcomes[slot] = outcome
@@ -177,7 +215,7 @@ class _Transfer:
         index: int,
         sub: int,
         timeout: float,
-        completion: _FutureCompletion | TransferBatch,
+        completion: _FutureCompletion | TransferBatch[Any],
         slot: int = 0,
         download: bytes | None = None,
         abort_on_timeout: bool = True,
@@ -199,6 +237,31 @@ class _Transfer:
         self.repeated = False
 
 
+class _NodeQueue:
+    """A node's waiting transfers in two lanes: what someone waits for interactively goes ahead of bulk work, each
+    lane in the order it was queued."""
+
+    __slots__ = ("bulk", "interactive")
+
+    def __init__(self) -> None:
+        self.interactive: deque[_Transfer] = deque()
+        self.bulk: deque[_Transfer] = deque()
+
+    def add(self, transfers: list[_Transfer], bulk: bool) -> None:
+        (self.bulk if bulk else self.interactive).extend(transfers)
+
+    def next(self) -> _Transfer | None:
+        lane = self.interactive or self.bulk
+        return lane.popleft() if lane else None
+
+    def drain(self) -> list[_Transfer]:
+        """Every waiting transfer, taken out of the queue (the link is gone)."""
+        waiting = [*self.interactive, *self.bulk]
+        self.interactive.clear()
+        self.bulk.clear()
+        return waiting
+
+
 def _stale(transfer: _Transfer, data: bytes) -> bool:
     """An answer that belongs to an earlier request: a late reply about another object (after a timeout), or a
     second reply to a repeated initiate request while the segments are already running."""
@@ -217,7 +280,7 @@ class SdoEngine:
         self.link = link
         self.timeout = timeout
         self._lock = threading.RLock()  # futures' callbacks may submit the next transfer
-        self._queues: dict[int, deque[_Transfer]] = {}
+        self._queues: dict[int, _NodeQueue] = {}
         self._active: dict[int, _Transfer] = {}
         self._finished: deque[tuple[_Transfer, object]] = deque()  # outcomes to hand over once the lock is free
         link.add_ticker(self._check_timeouts)
@@ -233,11 +296,13 @@ class SdoEngine:
         timeout: float | None = None,
         probe: bool = False,
         convert: Callable[[bytes], object] | None = None,
+        bulk: bool = False,
     ) -> Future:
         """Read an object; the future gives its bytes, or ``convert(bytes)`` (a ValueError fails the future).
 
         A ``probe`` (scan) sends no abort when the node stays silent: there is nobody to tell, and on a slow serial
-        link 127 useless abort frames would cost most of a second.
+        link 127 useless abort frames would cost most of a second.  ``bulk`` queues it behind interactive requests,
+        as part of a long operation.
         """
         completion = _FutureCompletion(convert)
         self._submit(
@@ -251,7 +316,8 @@ class SdoEngine:
                     abort_on_timeout=not probe,
                     retries=0 if probe else UPLOAD_RETRIES,
                 )
-            ]
+            ],
+            bulk,
         )
         return completion.future
 
@@ -260,17 +326,19 @@ class SdoEngine:
         node: int,
         objects: Sequence[tuple[int, int]],
         timeout: float | None = None,
-        convert: Callable[[int, bytes], object] | None = None,
-        on_each: Callable[[int, object], None] | None = None,
-    ) -> TransferBatch:
+        convert: Callable[[int, bytes], R] | None = None,
+        on_each: Callable[[int, R | Exception], None] | None = None,
+    ) -> TransferBatch[R]:
         """Read many objects of one node, back to back, in order, with one future for all (see `TransferBatch`)."""
         batch = TransferBatch(len(objects), convert, on_each)
         timeout = timeout or self.timeout
+        batch.patience += len(objects) * timeout * (1 + UPLOAD_RETRIES)
         self._submit(
             [
                 _Transfer(node, index, sub, timeout, batch, slot, retries=UPLOAD_RETRIES)
                 for slot, (index, sub) in enumerate(objects)
-            ]
+            ],
+            bulk=True,
         )
         return batch
 
@@ -279,19 +347,21 @@ class SdoEngine:
         node: int,
         writes: Sequence[tuple[int, int, bytes]],
         timeout: float | None = None,
-        convert: Callable[[int, None], object] | None = None,
-        on_each: Callable[[int, object], None] | None = None,
-    ) -> TransferBatch:
+        convert: Callable[[int, None], R] | None = None,
+        on_each: Callable[[int, R | Exception], None] | None = None,
+    ) -> TransferBatch[R]:
         """Write many objects of one node, back to back, in order, with one future for all (see `TransferBatch`)."""
         if any(not data for _, _, data in writes):
             raise ValueError("an SDO download needs at least one byte")
         batch = TransferBatch(len(writes), convert, on_each)
         timeout = timeout or self.timeout
+        batch.patience += len(writes) * timeout
         self._submit(
             [
                 _Transfer(node, index, sub, timeout, batch, slot, download=bytes(data))
                 for slot, (index, sub, data) in enumerate(writes)
-            ]
+            ],
+            bulk=True,
         )
         return batch
 
@@ -303,17 +373,19 @@ class SdoEngine:
         data: bytes,
         timeout: float | None = None,
         convert: Callable[[None], object] | None = None,
+        bulk: bool = False,
     ) -> Future:
-        """Write an object; the future gives None (or ``convert(None)``) once the drive confirmed."""
+        """Write an object; the future gives None (or ``convert(None)``) once the drive confirmed (``bulk``: as
+        part of a long operation, behind interactive requests)."""
         if not data:
             raise ValueError("an SDO download needs at least one byte")
         completion = _FutureCompletion(convert)
-        self._submit([_Transfer(node, index, sub, timeout or self.timeout, completion, download=bytes(data))])
+        self._submit([_Transfer(node, index, sub, timeout or self.timeout, completion, download=bytes(data))], bulk)
         return completion.future
 
     # -- internals ---------------------------------------------------------------------------------------------
-    def _submit(self, transfers: list[_Transfer]) -> None:
-        """Queue transfers (all of one node) and start the first if the node is idle."""
+    def _submit(self, transfers: list[_Transfer], bulk: bool) -> None:
+        """Queue transfers (all of one node) in the lane ``bulk`` names and start the first if the node is idle."""
         if not transfers:
             return
         node = transfers[0].node
@@ -321,9 +393,9 @@ class SdoEngine:
             raise ValueError(f"node ID {node} outside 1..127")
         with self._lock:
             if node not in self._queues:
-                self._queues[node] = deque()
+                self._queues[node] = _NodeQueue()
                 self.link.subscribe(SDO_RESPONSE + node, self._on_response)
-            self._queues[node].extend(transfers)
+            self._queues[node].add(transfers, bulk)
             if node not in self._active:
                 self._start_next(node)
         self._hand_over()
@@ -331,8 +403,7 @@ class SdoEngine:
     def _start_next(self, node: int) -> None:
         """Start the next queued transfer of ``node`` (lock held); failures to send complete it at once."""
         queue = self._queues[node]
-        while queue:
-            transfer = queue.popleft()
+        while (transfer := queue.next()) is not None:
             if not transfer.completion.start(transfer.slot):  # cancelled before it was sent
                 self._finished.append((transfer, CancelledError()))
                 continue
@@ -402,8 +473,8 @@ class SdoEngine:
             raise SdoError(transfer.node, transfer.index, transfer.sub, "segment toggle bit not alternated")
         transfer.received += data[1 : 8 - ((command >> 1) & 0x7)]
         if command & 0x01:  # last segment
-            size = transfer.expected_size
-            self._finish(transfer, bytes(transfer.received[:size] if size is not None else transfer.received))
+            expected = transfer.expected_size
+            self._finish(transfer, bytes(transfer.received[:expected] if expected is not None else transfer.received))
             return None
         transfer.toggle ^= 1
         return bytes([0x60 | transfer.toggle << 4]) + bytes(7)
@@ -488,16 +559,10 @@ class SdoEngine:
         with self._lock:
             pending = list(self._active.values())
             for queue in self._queues.values():
-                pending += queue
-                queue.clear()
+                pending += queue.drain()
             self._active.clear()
+            what = "was closed" if self.link.closed else f"lost: {reason}"
             for transfer in pending:
-                self._finished.append(
-                    (
-                        transfer,
-                        SdoLinkError(
-                            transfer.node, transfer.index, transfer.sub, f"bus {self.link.name} lost: {reason}"
-                        ),
-                    )
-                )
+                error = SdoLinkError(transfer.node, transfer.index, transfer.sub, f"bus {self.link.name} {what}")
+                self._finished.append((transfer, error))
         self._hand_over()

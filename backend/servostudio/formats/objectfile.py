@@ -16,6 +16,7 @@ from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from servostudio.errors import InvalidInput
 from servostudio.formats.numbers import parse_integer
 from servostudio.formats.textfile import FILE_ENCODING, split_lines, write_text_atomic
 
@@ -42,7 +43,7 @@ class ObjectEntry:
     line: int = field(default=0, compare=False)
 
 
-class ObjectFileError(ValueError):
+class ObjectFileError(InvalidInput):
     """A malformed or duplicate assignment, located as ``FILE:LINE: reason``."""
 
     def __init__(self, file: str, line: int, reason: str) -> None:

@@ -16,6 +16,7 @@ import os
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from servostudio.errors import InvalidInput
 from servostudio.formats.numbers import parse_integer
 from servostudio.formats.sequence_model import BitPattern, Sequence, SequenceTable, Value, value_problem
 from servostudio.formats.sequence_spec import (
@@ -46,7 +47,7 @@ class SequenceIssue:
         return f"line {self.line}: {where}{self.reason}"
 
 
-class SequenceFileError(ValueError):
+class SequenceFileError(InvalidInput):
     """Every problem found in a sequence file; ``issues`` is ordered by line."""
 
     def __init__(self, file: str, issues: list[SequenceIssue]) -> None:

@@ -14,6 +14,8 @@ import enum
 import math
 import struct
 
+from servostudio.errors import InvalidInput
+
 
 class DataType(enum.IntEnum):
     """CiA 301 static data type codes (object index 0x0001–0x001B)."""
@@ -48,6 +50,14 @@ class DataType(enum.IntEnum):
     def size(self) -> int | None:
         """Encoded size in bytes; None for variable-length types (strings, DOMAIN)."""
         return _SIZES.get(self)
+
+    @property
+    def fixed_size(self) -> int:
+        """Encoded size in bytes of a number, BOOLEAN or TIME type, for code that has ruled out the others."""
+        size = self.size
+        if size is None:
+            raise ValueError(f"{self.name} has no fixed size")
+        return size
 
     @property
     def bits(self) -> int | None:
@@ -89,7 +99,7 @@ class DataType(enum.IntEnum):
     def min_value(self) -> int | None:
         """Smallest integer value (BOOLEAN and TIME types included); None for non-integer types."""
         if self in _SIGNED:
-            return -(1 << (self.size * 8 - 1))
+            return -(1 << (self.fixed_size * 8 - 1))
         if self in _UNSIGNED or self.is_time:
             return 0
         return None
@@ -100,10 +110,18 @@ class DataType(enum.IntEnum):
         if self is DataType.BOOLEAN:
             return 1
         if self in _SIGNED:
-            return (1 << (self.size * 8 - 1)) - 1
+            return (1 << (self.fixed_size * 8 - 1)) - 1
         if self in _UNSIGNED or self.is_time:
-            return (1 << (self.size * 8)) - 1
+            return (1 << (self.fixed_size * 8)) - 1
         return None
+
+    @property
+    def integer_range(self) -> tuple[int, int]:
+        """``(min_value, max_value)`` of an integer, BOOLEAN or TIME type; ValueError for the others."""
+        low, high = self.min_value, self.max_value
+        if low is None or high is None:
+            raise ValueError(f"{self.name} is not an integer type")
+        return low, high
 
 
 _SIGNED = frozenset(
@@ -158,7 +176,7 @@ _FLOAT_FORMATS = {DataType.REAL32: "<f", DataType.REAL64: "<d"}
 _TIME_RESERVED_BITS = 0xF000_0000
 
 
-class EncodingError(ValueError):
+class EncodingError(InvalidInput):
     """A value cannot be represented in (or decoded from) a CiA 301 data type."""
 
 
@@ -222,13 +240,12 @@ def _encode_integer(data_type: DataType, value: int | float | str | bytes) -> by
     if not isinstance(value, int):
         raise EncodingError(f"{data_type.name} needs an int, got {type(value).__name__}")
     _check_integer(data_type, value)
-    return value.to_bytes(data_type.size, "little", signed=data_type in _SIGNED)
+    return value.to_bytes(data_type.fixed_size, "little", signed=data_type in _SIGNED)
 
 
 def _check_integer(data_type: DataType, value: int) -> None:
-    if not data_type.min_value <= value <= data_type.max_value:
-        raise EncodingError(
-            f"{value} is outside the {data_type.name} range {data_type.min_value}..{data_type.max_value}"
-        )
+    low, high = data_type.integer_range
+    if not low <= value <= high:
+        raise EncodingError(f"{value} is outside the {data_type.name} range {low}..{high}")
     if data_type.is_time and value & _TIME_RESERVED_BITS:
         raise EncodingError(f"{data_type.name} value {value:#x} sets the reserved bits 28-31")

@@ -11,7 +11,7 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 
 from servostudio.od.datatypes import DataType
-from servostudio.od.eds_values import ValueSyntaxError, parse_integer, parse_value
+from servostudio.od.eds_values import ValueSyntaxError, parse_integer, parse_number, parse_value
 from servostudio.od.ini import IniFile, IniSection, read_ini
 from servostudio.od.model import (
     Access,
@@ -118,7 +118,7 @@ class _EdsReader:
         for sub, key, expected in ((1, "VendorNumber", info.vendor_id), (2, "ProductNumber", info.product_code)):
             var = identity.get(sub)
             if var is not None and isinstance(var.default, int) and var.default not in (0, expected):
-                section = self.ini.section("DeviceInfo")
+                section = self.ini.known_section("DeviceInfo")
                 raise self.error(
                     section, section.line_of(key), f"{key} {expected:#x} differs from 0x1018,{sub} ({var.default:#x})"
                 )
@@ -145,7 +145,7 @@ class _EdsReader:
                 if self.ini.section(f"{index:04X}") is None:
                     raise self.error(section, line, f"listed object 0x{index:04X} has no section [{index:04X}]")
                 listed[index] = section.name
-        mandatory = self.ini.section("MandatoryObjects")
+        mandatory = self.ini.known_section("MandatoryObjects")
         for index in _MANDATORY:
             if listed.get(index, "").lower() != "mandatoryobjects":
                 raise self.error(mandatory, mandatory.line, f"mandatory object 0x{index:04X} is not listed")
@@ -157,11 +157,11 @@ class _EdsReader:
             raise self.error(section, section.line, "SupportedObjects is missing")
         count = self._integer(section, "SupportedObjects")
         entries = []
-        for entry in section:
-            if entry.key.lower() == "supportedobjects":
+        for listed in section:
+            if listed.key.lower() == "supportedobjects":
                 continue
-            if not entry.key.isdigit() or not 1 <= int(entry.key) <= count:
-                raise self.error(section, entry.line, f"unexpected entry {entry.key!r} (SupportedObjects={count})")
+            if not listed.key.isdigit() or not 1 <= int(listed.key) <= count:
+                raise self.error(section, listed.line, f"unexpected entry {listed.key!r} (SupportedObjects={count})")
         for number in range(1, count + 1):
             entry = section.entry(str(number))
             if entry is None:
@@ -200,7 +200,7 @@ class _EdsReader:
         """A [xxxxsubN] section needs a parent with SubNumber, an [xxxxName]/[xxxxValue] one with CompactSubObj."""
         if int(index_text, 16) not in listed:
             raise self.error(section, section.line, f"object [{index_text}] is not defined")
-        parent = self.ini.section(index_text)
+        parent = self.ini.known_section(index_text)
         key = "SubNumber" if kind == "sub" else "CompactSubObj"
         if not parent.get(key):
             raise self.error(section, section.line, f"object [{index_text}] has no {key}")
@@ -208,7 +208,7 @@ class _EdsReader:
     # --- objects ------------------------------------------------------------------------------------------------
 
     def _object(self, index: int) -> DictObject:
-        section = self.ini.section(f"{index:04X}")
+        section = self.ini.known_section(f"{index:04X}")
         self._check_keys(section)
         name = self._name(section)
         object_type = self._integer(section, "ObjectType", 0x7)
@@ -248,7 +248,7 @@ class _EdsReader:
         if 0 not in subs:
             raise self.error(section, section.line_of("SubNumber"), f"[{index:04X}sub0] is missing")
         if subs[0].data_type is not DataType.UNSIGNED8:
-            sub0 = self.ini.section(f"{index:04X}sub0")
+            sub0 = self.ini.known_section(f"{index:04X}sub0")
             raise self.error(sub0, sub0.line_of("DataType"), "sub-index 0 must be UNSIGNED8")
         return subs
 
@@ -362,7 +362,7 @@ class _EdsReader:
             return None
         if not data_type.is_numeric:
             raise self.error(section, section.line_of(key), f"{key} is not allowed for {data_type.name}")
-        value = self._value(section, key, data_type, allow_node_id=False)[0]
+        value = self._number(section, key, text, data_type, allow_node_id=False)[0]
         self._check_type_range(section, key, data_type, value)
         return value
 
@@ -373,30 +373,37 @@ class _EdsReader:
         text = section.get(key)
         if text is None or (text == "" and not (data_type.is_text or data_type.is_binary)):
             return None, False, None
-        value, uses_node_id = self._value(section, key, data_type, allow_node_id=data_type.is_integer)
+        if not (data_type.is_numeric or data_type.is_time):
+            return self._value(section, key, text, data_type), False, text
+        value, uses_node_id = self._number(section, key, text, data_type, allow_node_id=data_type.is_integer)
         candidates = [value + node for node in (NODE_IDS[0], NODE_IDS[-1])] if uses_node_id else [value]
-        for candidate in candidates if data_type.is_numeric or data_type.is_time else []:
+        for candidate in candidates:
             self._check_type_range(section, key, data_type, candidate)
             if (low is not None and candidate < low) or (high is not None and candidate > high):
                 raise self.error(section, section.line_of(key), f"{key} {text} is outside the limits {low}..{high}")
         return value, uses_node_id, text
 
-    def _value(
-        self, section: IniSection, key: str, data_type: DataType, allow_node_id: bool
-    ) -> tuple[int | float | str | bytes, bool]:
+    def _value(self, section: IniSection, key: str, text: str, data_type: DataType) -> int | float | str | bytes:
         try:
-            return parse_value(data_type, section.get(key), allow_node_id)
+            return parse_value(data_type, text)[0]
+        except ValueSyntaxError as exc:
+            raise self.error(section, section.line_of(key), f"{key}: {exc}") from None
+
+    def _number(
+        self, section: IniSection, key: str, text: str, data_type: DataType, allow_node_id: bool
+    ) -> tuple[int | float, bool]:
+        try:
+            return parse_number(data_type, text, allow_node_id)
         except ValueSyntaxError as exc:
             raise self.error(section, section.line_of(key), f"{key}: {exc}") from None
 
     def _check_type_range(self, section: IniSection, key: str, data_type: DataType, value: int | float) -> None:
         if data_type.is_float:
             return
-        if not data_type.min_value <= value <= data_type.max_value:
+        low, high = data_type.integer_range
+        if not low <= value <= high:
             raise self.error(
-                section,
-                section.line_of(key),
-                f"{key} {value} is outside the {data_type.name} range {data_type.min_value}..{data_type.max_value}",
+                section, section.line_of(key), f"{key} {value} is outside the {data_type.name} range {low}..{high}"
             )
 
     def _integer(self, section: IniSection, key: str, default: int | None = None) -> int:

@@ -14,12 +14,13 @@ from __future__ import annotations
 import re
 import struct
 
+from servostudio.errors import InvalidInput
 from servostudio.od.datatypes import DataType
 
 _NODE_ID = re.compile(r"^\s*\$nodeid\s*(?:\+\s*(?P<after>.+?))?\s*$|^\s*(?P<before>.+?)\s*\+\s*\$nodeid\s*$", re.I)
 
 
-class ValueSyntaxError(ValueError):
+class ValueSyntaxError(InvalidInput):
     """A value text cannot be read; the message is the reason, without location."""
 
 
@@ -48,6 +49,11 @@ def parse_value(data_type: DataType, text: str, allow_node_id: bool = False) -> 
         return text, False
     if data_type.is_binary:
         return _parse_hex_bytes(text), False
+    return parse_number(data_type, text, allow_node_id)
+
+
+def parse_number(data_type: DataType, text: str, allow_node_id: bool = False) -> tuple[int | float, bool]:
+    """`parse_value` for the numeric, BOOLEAN and TIME types, typed as a number for the range checks that follow."""
     if data_type.is_float:
         return _parse_float(data_type, text), False
     node_id = _NODE_ID.match(text)
@@ -63,7 +69,7 @@ def _parse_float(data_type: DataType, text: str) -> float:
     body = text.strip()
     if body.lower().lstrip("+-").startswith("0x"):
         pattern = parse_integer(body)
-        size = data_type.size
+        size = data_type.fixed_size
         if not 0 <= pattern < 1 << (8 * size):
             raise ValueSyntaxError(f"{text!r} is not a {size * 8}-bit IEEE-754 bit pattern")
         fmt = "<f" if data_type is DataType.REAL32 else "<d"
@@ -85,5 +91,5 @@ def _parse_hex_bytes(text: str) -> bytes:
 def float_bit_pattern(data_type: DataType, value: float) -> str:
     """The EDS spelling of a REAL value that both our reader and dcf-tools understand."""
     fmt = "<f" if data_type is DataType.REAL32 else "<d"
-    digits = data_type.size * 2
+    digits = data_type.fixed_size * 2
     return f"0x{int.from_bytes(struct.pack(fmt, value), 'little'):0{digits}X}"

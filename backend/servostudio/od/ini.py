@@ -77,6 +77,13 @@ class IniFile:
     def section(self, name: str) -> IniSection | None:
         return self._sections.get(name.casefold())
 
+    def known_section(self, name: str) -> IniSection:
+        """A section the reader has already found to exist; a KeyError here is a programming error."""
+        section = self.section(name)
+        if section is None:
+            raise KeyError(f"section [{name}] was expected to exist")
+        return section
+
     def add(self, section: IniSection) -> None:
         lowered = section.name.casefold()
         if lowered in self._sections:

@@ -11,20 +11,33 @@ import re
 import shutil
 import tempfile
 import threading
+from collections.abc import Mapping
 from pathlib import Path
 
+from servostudio.errors import InvalidInput
 from servostudio.od.eds import load_dictionary
 from servostudio.od.model import ObjectDictionary
 
-BUILTIN_EDS_DIR = Path(os.environ.get("SERVOSTUDIO_EDS_DIR") or Path(__file__).resolve().parents[3] / "eds")
-DEFAULT_USER_EDS_DIR = Path(
-    os.environ.get("SERVOSTUDIO_USER_EDS_DIR")
-    or Path(os.environ.get("XDG_DATA_HOME") or Path.home() / ".local" / "share") / "servostudio" / "eds"
-)
+#: the repository's ``eds/`` folder; ``builtin_eds_dir()`` is what a process uses
+BUILTIN_EDS_DIR = Path(__file__).resolve().parents[3] / "eds"
+
+
+def builtin_eds_dir(environ: Mapping[str, str] = os.environ) -> Path:
+    """The built-in dictionaries: ``SERVOSTUDIO_EDS_DIR``, else the repository's ``eds/`` (read when asked, so
+    importing this module reads no environment)."""
+    return Path(environ.get("SERVOSTUDIO_EDS_DIR") or BUILTIN_EDS_DIR)
+
+
+def default_user_eds_dir(environ: Mapping[str, str] = os.environ) -> Path:
+    """Imported dictionaries: ``SERVOSTUDIO_USER_EDS_DIR``, else ``$XDG_DATA_HOME/servostudio/eds``."""
+    data_home = Path(environ.get("XDG_DATA_HOME") or Path.home() / ".local" / "share")
+    return Path(environ.get("SERVOSTUDIO_USER_EDS_DIR") or data_home / "servostudio" / "eds")
+
+
 _KEY = re.compile(r"^[a-z0-9][a-z0-9_.-]*$")
 
 
-class LibraryError(ValueError):
+class LibraryError(InvalidInput):
     """An import was refused (bad name, key clash) or a device key is unknown."""
 
 
@@ -73,7 +86,7 @@ class EdsLibrary:
             props_path = candidate if candidate.exists() else None
         load_dictionary(eds_path, props_path)
         self.user_dir.mkdir(parents=True, exist_ok=True)
-        self._install(eds_path, props_path, key)
+        self._install(self.user_dir, eds_path, props_path, key)
         with self._lock:
             self._cache.pop(key, None)
         return key
@@ -87,9 +100,9 @@ class EdsLibrary:
                 return device
         return None
 
-    def _install(self, eds_path: Path, props_path: Path | None, key: str) -> None:
-        target_eds = self.user_dir / f"{key}.eds"
-        target_props = self.user_dir / f"{key}.props"
+    def _install(self, user_dir: Path, eds_path: Path, props_path: Path | None, key: str) -> None:
+        target_eds = user_dir / f"{key}.eds"
+        target_props = user_dir / f"{key}.props"
         staged = [(self._stage(eds_path), target_eds)]
         if props_path is not None:
             staged.append((self._stage(Path(props_path)), target_props))
@@ -119,8 +132,9 @@ _builtin: EdsLibrary | None = None
 
 
 def builtin_library() -> EdsLibrary:
-    """Process-wide library: the built-in directory plus the user directory (env SERVOSTUDIO_USER_EDS_DIR)."""
+    """Process-wide library: the built-in directory plus the user directory, as the environment names them when
+    it is first asked for."""
     global _builtin
     if _builtin is None:
-        _builtin = EdsLibrary(BUILTIN_EDS_DIR, DEFAULT_USER_EDS_DIR)
+        _builtin = EdsLibrary(builtin_eds_dir(), default_user_eds_dir())
     return _builtin

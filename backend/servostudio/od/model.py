@@ -12,10 +12,11 @@ from collections.abc import Iterator, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from servostudio.errors import InvalidInput
 from servostudio.od.datatypes import DataType
 
 
-class DictionaryError(ValueError):
+class DictionaryError(InvalidInput):
     """A dictionary file is malformed; names the file, the line, the section and the reason."""
 
     def __init__(self, file: Path | str, line: int, section: str, reason: str) -> None:
@@ -26,15 +27,15 @@ class DictionaryError(ValueError):
         super().__init__(f"{self.file}:{line}: [{section}] {reason}")
 
 
-class OutOfRange(ValueError):
+class OutOfRange(InvalidInput):
     """A value lies outside the limits of the object it is meant for."""
 
 
-class WrongType(TypeError, ValueError):
+class WrongType(InvalidInput, TypeError):
     """A value has a Python type the object's data type cannot hold."""
 
 
-class Access(str, enum.Enum):
+class Access(enum.StrEnum):
     """CiA 306 AccessType; rwr/rww are read-write objects preferably mapped into TPDOs/RPDOs."""
 
     RO = "ro"
@@ -53,7 +54,7 @@ class Access(str, enum.Enum):
         return self in (Access.WO, Access.RW, Access.RWR, Access.RWW)
 
 
-class SaveType(str, enum.Enum):
+class SaveType(enum.StrEnum):
     """Which drive file an object's value is saved in (XtrapulsPac: DRIVEPAR.TXT or USER_PAR.TXT)."""
 
     DRIVEPAR = "DRIVEPAR"
@@ -61,7 +62,7 @@ class SaveType(str, enum.Enum):
     NONE = "NONE"
 
 
-class ObjectKind(str, enum.Enum):
+class ObjectKind(enum.StrEnum):
     """CiA 306 ObjectType of a dictionary entry (DOMAIN objects are VARs whose data type is DOMAIN)."""
 
     VAR = "VAR"

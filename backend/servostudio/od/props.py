@@ -10,11 +10,13 @@ from __future__ import annotations
 
 import math
 import re
+from collections.abc import Callable
 from dataclasses import dataclass, field, replace
+from typing import Any
 
 from servostudio.od.datatypes import DataType
 from servostudio.od.eds_values import ValueSyntaxError, parse_integer
-from servostudio.od.ini import IniFile, IniSection
+from servostudio.od.ini import IniEntry, IniFile, IniSection
 from servostudio.od.model import BitField, DictionaryError, DictObject, ObjectKind, SaveType, Variable
 
 _OBJECT = re.compile(r"^(?P<index>[0-9A-F]{4})(?:sub(?P<sub>[0-9A-F]{1,2}))?$", re.IGNORECASE)
@@ -23,6 +25,7 @@ _BIT = re.compile(r"^bit\.(?P<bit>\d+)$", re.IGNORECASE)
 _BITS = re.compile(r"^bits\.(?P<first>\d+)-(?P<last>\d+)$", re.IGNORECASE)
 _TEXT_KEYS = frozenset({"group", "description", "unit", "reference"})
 _VALUE_KEYS = frozenset({"unit", "scale", "offset", "pointer", "enum", "bits"})
+_Fail = Callable[[str], DictionaryError]  # builds the error for the entry being read, from a reason
 
 
 @dataclass
@@ -82,7 +85,7 @@ def _read_section(ini: IniFile, section: IniSection) -> _Props:
     for entry in section:
         key = entry.key.lower()
 
-        def fail(reason: str, entry=entry) -> DictionaryError:
+        def fail(reason: str, entry: IniEntry = entry) -> DictionaryError:
             return DictionaryError(ini.path, entry.line, section.name, reason)
 
         if key in _TEXT_KEYS:
@@ -109,7 +112,7 @@ def _read_section(ini: IniFile, section: IniSection) -> _Props:
     return props
 
 
-def _real(text: str, key: str, nonzero: bool, fail) -> float:
+def _real(text: str, key: str, nonzero: bool, fail: _Fail) -> float:
     try:
         value = float(text)
     except ValueError:
@@ -119,7 +122,7 @@ def _real(text: str, key: str, nonzero: bool, fail) -> float:
     return value
 
 
-def _add_enum(props: _Props, value_text: str, name: str, fail) -> None:
+def _add_enum(props: _Props, value_text: str, name: str, fail: _Fail) -> None:
     try:
         value = parse_integer(value_text)
     except ValueSyntaxError as exc:
@@ -132,7 +135,7 @@ def _add_enum(props: _Props, value_text: str, name: str, fail) -> None:
     props.enum[value] = name
 
 
-def _add_bits(props: _Props, first: int, last: int, name: str, line: int, fail) -> None:
+def _add_bits(props: _Props, first: int, last: int, name: str, line: int, fail: _Fail) -> None:
     if first > last:
         raise fail(f"bit range {first}-{last} is reversed")
     if not name:
@@ -148,9 +151,9 @@ def _apply(ini: IniFile, var: Variable, inherited: _Props | None, own: _Props | 
     layers = [p for p in (inherited, own) if p is not None]
     if not layers:
         return var
-    changes: dict[str, object] = {}
-    enum_source: _Props | None = None
-    bits_source: _Props | None = None
+    changes: dict[str, Any] = {}  # Variable field name -> value; `replace` rejects an unknown name
+    enum_source: tuple[IniSection, dict[int, str]] | None = None
+    bits_source: tuple[IniSection, list[tuple[BitField, int]]] | None = None
     for layer in layers:
         value_keys_apply = layer is own or inherit_values
         for key, value in layer.values.items():
@@ -158,49 +161,61 @@ def _apply(ini: IniFile, var: Variable, inherited: _Props | None, own: _Props | 
                 continue
             changes[{"savetype": "save_type", "pointer": "is_pointer"}.get(key, key)] = value
         if value_keys_apply and layer.enum is not None:
-            enum_source = layer
+            enum_source = (layer.section, layer.enum)
         if value_keys_apply and layer.bits is not None:
-            bits_source = layer
+            bits_source = (layer.section, layer.bits)
     if enum_source is not None:
-        _check_enum(ini, var, enum_source)
-        changes["enum"] = dict(enum_source.enum)
+        _check_enum(ini, var, *enum_source)
+        changes["enum"] = dict(enum_source[1])
     if bits_source is not None:
-        _check_bits(ini, var, bits_source)
-        changes["bits"] = tuple(sorted((b for b, _ in bits_source.bits), key=lambda b: b.first))
+        _check_bits(ini, var, *bits_source)
+        changes["bits"] = tuple(sorted((b for b, _ in bits_source[1]), key=lambda b: b.first))
     if changes.get("is_pointer") and var.data_type is not DataType.UNSIGNED32:
-        section = (own or inherited).section
+        section = layers[-1].section
         raise DictionaryError(
             ini.path, section.line_of("Pointer"), section.name, f"Pointer needs UNSIGNED32, not {var.data_type.name}"
         )
     return replace(var, **changes)
 
 
-def _check_enum(ini: IniFile, var: Variable, props: _Props) -> None:
-    for value in props.enum:
-        if not var.data_type.is_integer or not var.data_type.min_value <= value <= var.data_type.max_value:
-            line = next(e.line for e in props.section if _ENUM.match(e.key) and _enum_value(e.key) == value)
+def _check_enum(ini: IniFile, var: Variable, section: IniSection, enum: dict[int, str]) -> None:
+    for value in enum:
+        if not _holds(var.data_type, value):
+            line = next(e.line for e in section if _enum_value(e.key) == value)
             raise DictionaryError(
                 ini.path,
                 line,
-                props.section.name,
+                section.name,
                 f"Enum value {value} does not fit 0x{var.index:04X},{var.subindex} ({var.data_type.name})",
             )
 
 
+def _holds(data_type: DataType, value: int) -> bool:
+    """Whether an enumeration value fits the object: only integer objects have enumerations."""
+    if not data_type.is_integer:
+        return False
+    low, high = data_type.integer_range
+    return low <= value <= high
+
+
 def _enum_value(key: str) -> int | None:
+    """The value an ``Enum.<value>`` key names; None for any other key."""
+    match = _ENUM.match(key)
+    if match is None:
+        return None
     try:
-        return parse_integer(_ENUM.match(key)["value"])
+        return parse_integer(match["value"])
     except ValueSyntaxError:
         return None
 
 
-def _check_bits(ini: IniFile, var: Variable, props: _Props) -> None:
+def _check_bits(ini: IniFile, var: Variable, section: IniSection, bits: list[tuple[BitField, int]]) -> None:
     width = var.data_type.bits if var.data_type.is_integer else None
-    for bit_field, line in props.bits:
+    for bit_field, line in bits:
         if width is None or bit_field.last >= width:
             raise DictionaryError(
                 ini.path,
                 line,
-                props.section.name,
+                section.name,
                 f"bit {bit_field.last} does not exist in 0x{var.index:04X},{var.subindex} ({var.data_type.name})",
             )

@@ -17,6 +17,7 @@ SEQUENCE.TXT goes through 0x3610 (select) / 0x3611 (26 parameters) with ``servos
 from __future__ import annotations
 
 import enum
+import logging
 import struct
 import threading
 import time
@@ -24,23 +25,28 @@ from collections.abc import Callable, Iterable
 from concurrent.futures import CancelledError, Future, ThreadPoolExecutor, wait
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TypeVar
 
 from servostudio.drive.access import Drive, DriveAccessError
 from servostudio.drive.cia402 import State, decode_state
 from servostudio.drive.object_values import ObjectValue
-from servostudio.drive.sdo import SdoAbortError, SdoError, TransferBatch
-from servostudio.formats.objectfile import ObjectEntry, ObjectFileError, read_object_file, write_object_file
-from servostudio.formats.sequence import SequenceFileError, SequenceTable, read_sequence_file, write_sequence_file
+from servostudio.drive.sdo import SAFETY_WAIT, SdoAbortError, SdoError, TransferBatch, settle
+from servostudio.errors import CommunicationError, InvalidInput, RefusedForSafety, ServoStudioError
+from servostudio.formats.objectfile import ObjectEntry, ObjectFileError, parse_object_file, write_object_file
+from servostudio.formats.sequence import SequenceFileError, SequenceTable, parse_sequence_text, write_sequence_file
+from servostudio.formats.textfile import FILE_ENCODING
 from servostudio.od.datatypes import DataType
 from servostudio.od.model import SaveType, Variable
 from servostudio.services.cancel import Cancellation, Cancelled
 
+log = logging.getLogger(__name__)
 Progress = Callable[[dict[str, object]], None]
+T = TypeVar("T")
 SAVE_TIMEOUT = 10.0
 _PROGRESS_STEPS = 20
 
 
-class FileKind(str, enum.Enum):
+class FileKind(enum.StrEnum):
     DRIVEPAR = "DRIVEPAR.TXT"
     USER_PAR = "USER_PAR.TXT"
     SEQUENCE = "SEQUENCE.TXT"
@@ -50,7 +56,7 @@ class FileKind(str, enum.Enum):
         """The kind a file name says (case-insensitive, ``node3_DRIVEPAR.TXT`` too); DRIVEPAR otherwise."""
         name = path.name.upper()
         for kind in cls:
-            if name.endswith(kind.value) or name.endswith(kind.value.rsplit(".", 1)[0]):
+            if name.endswith((kind.value, kind.value.rsplit(".", 1)[0])):
                 return kind
         return cls.DRIVEPAR
 
@@ -59,12 +65,16 @@ class FileKind(str, enum.Enum):
         return {FileKind.DRIVEPAR: SaveType.DRIVEPAR, FileKind.USER_PAR: SaveType.USER_PAR}.get(self)
 
 
-class BackupError(RuntimeError):
+class BackupError(CommunicationError, RuntimeError):
     """A backup or restore that could not complete; nothing half-written is left behind."""
 
 
-class RestoreValidationError(BackupError):
+class RestoreValidationError(InvalidInput, BackupError):
     """The file is invalid; nothing was sent to the drive.  The message is ``FILE:LINE: reason``."""
+
+
+class DriveNotDisabled(RefusedForSafety, BackupError):
+    """The device stores parameters only while disabled and the drive is enabled; nothing was written."""
 
 
 @dataclass
@@ -160,6 +170,7 @@ def backup_file(
         table = _read_sequences(drive, progress)
         write_sequence_file(path, table, header=_header(drive, kind))
         return BackupResult(drive.node, str(path), kind.value, len(table), seconds=time.monotonic() - started)
+    assert kind.save_type is not None  # every file but SEQUENCE.TXT holds objects of one save type
     variables = backup_objects(drive, kind.save_type)
     values, skipped = _read_all(drive, variables, kind, progress, cancel)
     entries = []
@@ -192,8 +203,9 @@ def _read_all(
     outcomes = _wait_batch(drive.submit_read_all(variables, on_each=lambda position, outcome: reporter.step()), cancel)
     if cancel is not None and cancel.requested:
         raise Cancelled(f"backup of node {drive.node} ({kind.value}) cancelled, no file written")
-    values, skipped = [], []
-    for var, outcome in zip(variables, outcomes):
+    values: list[ObjectValue] = []
+    skipped: list[dict[str, str]] = []
+    for var, outcome in zip(variables, outcomes, strict=True):
         if isinstance(outcome, SdoAbortError):
             skipped.append({"object": var.label, "reason": outcome.reason})
         elif isinstance(outcome, SdoError):
@@ -215,7 +227,7 @@ def _wait_all(futures: list[Future], reporter: _Reporter) -> None:
     """
     for future in futures:
         future.add_done_callback(reporter.step_done)
-    wait(futures)
+    wait(futures, SAFETY_WAIT)
 
 
 def _file_value(value: ObjectValue) -> int | str:
@@ -226,6 +238,8 @@ def _file_value(value: ObjectValue) -> int | str:
         return int.from_bytes(struct.pack(fmt, raw), "little")
     if isinstance(raw, str):
         return raw.rstrip("\0")
+    if isinstance(raw, bytes):  # backup_objects leaves DOMAIN and OCTET_STRING out
+        raise BackupError(f"{value.variable.label}: a binary value has no object-file form")
     return raw
 
 
@@ -259,6 +273,30 @@ def backup_drive(
     return results
 
 
+def restore_drive(
+    drive: Drive,
+    directory: Path,
+    kinds: Iterable[FileKind] | None = None,
+    progress: Progress | None = None,
+    store: bool = True,
+    cancel: Cancellation | None = None,
+) -> list[RestoreResult]:
+    """Restore the backup files of a drive from ``directory`` (by default every file of the drive found there).
+
+    Files not started when a cancellation comes are left out of the result."""
+    chosen = list(kinds or [kind for kind in drive_file_kinds(drive) if (directory / kind.value).is_file()])
+    if not chosen:
+        raise RestoreValidationError(
+            f"node{drive.node}/: no DRIVEPAR.TXT, USER_PAR.TXT or SEQUENCE.TXT for node {drive.node}"
+        )
+    results = []
+    for kind in chosen:
+        if cancel is not None and cancel.requested:
+            break
+        results.append(restore_file(drive, directory / kind.value, kind, progress, store, cancel))
+    return results
+
+
 def drive_file_kinds(drive: Drive) -> list[FileKind]:
     kinds = [FileKind(name) for name in drive.profile.parameter_files]
     if drive.profile.has_sequences and drive.profile.has("sequence_parameters"):
@@ -266,22 +304,25 @@ def drive_file_kinds(drive: Drive) -> list[FileKind]:
     return kinds
 
 
-def run_per_drive(drives: list[Drive], work: Callable[[Drive], object]) -> dict[int, object]:
+def run_per_drive(drives: list[Drive], work: Callable[[Drive], T]) -> dict[int, T | Exception]:
     """Run ``work`` on every drive in parallel; the result per node is its value or the exception it raised."""
-    results: dict[int, object] = {}
+    results: dict[int, T | Exception] = {}
     with ThreadPoolExecutor(max_workers=max(1, len(drives)), thread_name_prefix="per-drive") as pool:
         futures = {drive.node: pool.submit(work, drive) for drive in drives}
         for node, future in futures.items():
             try:
                 results[node] = future.result()
-            except Exception as error:  # reported per drive, the others go on
+            except Exception as error:  # reported per drive, the others go on; a bug is logged as well
+                if not isinstance(error, ServoStudioError):
+                    log.exception("node %d: unexpected failure", node)
                 results[node] = error
     return results
 
 
 # --------------------------------------------------------------------------------------------------- restore --
-def validate_object_file(drive: Drive, path: Path) -> list[tuple[ObjectEntry, Variable, bytes]]:
-    """Parse and check the whole file; raise RestoreValidationError (file, line, reason) on the first problem."""
+def validate_object_text(drive: Drive, text: str, name: str) -> list[tuple[ObjectEntry, Variable, bytes]]:
+    """Parse and check a whole object file (``name`` as messages call it); raise RestoreValidationError
+    (``NAME:LINE: reason``) on the first problem."""
     checked: list[tuple[ObjectEntry, Variable, bytes]] = []
 
     def validate(entry: ObjectEntry) -> str | None:
@@ -295,11 +336,9 @@ def validate_object_file(drive: Drive, path: Path) -> list[tuple[ObjectEntry, Va
         return None
 
     try:
-        read_object_file(path, validate)
+        parse_object_file(text, name, validate)
     except ObjectFileError as error:
         raise RestoreValidationError(f"{error} — nothing was written to node {drive.node}") from None
-    except OSError as error:
-        raise RestoreValidationError(f"{path}: {error.strerror}") from None
     return checked
 
 
@@ -322,17 +361,40 @@ def restore_file(
     store: bool = True,
     cancel: Cancellation | None = None,
 ) -> RestoreResult:
-    """Validate, write, verify and store one file to one drive.
+    """Validate, write, verify and store one file of the server's disk to one drive (see `restore_text`)."""
+    kind = kind or FileKind.from_path(path)
+    try:
+        text = path.read_text(encoding=FILE_ENCODING)
+    except OSError as error:
+        raise RestoreValidationError(
+            f"{path.name}: {error.strerror} — nothing was written to node {drive.node}"
+        ) from None
+    return restore_text(drive, text, kind, progress, store, cancel, file=str(path))
+
+
+def restore_text(
+    drive: Drive,
+    text: str,
+    kind: FileKind,
+    progress: Progress | None = None,
+    store: bool = True,
+    cancel: Cancellation | None = None,
+    file: str | None = None,
+) -> RestoreResult:
+    """Validate, write, verify and store one drive file's text (an upload; any text: every byte is Latin-1, and an
+    empty file writes nothing) to one drive.  Messages name the file by its own name or, for an upload, its kind
+    (``DRIVEPAR.TXT:3: …``), never by a server path; ``file`` is what the result reports as its source (default: the
+    kind).
 
     A cancellation drops the writes not yet sent: the result lists which objects were written (not verified, not
     stored).  A sequence file is written whole once started (half a sequence memory is worth nothing)."""
-    kind = kind or FileKind.from_path(path)
     started = time.monotonic()
-    result = RestoreResult(drive.node, str(path), kind.value)
+    result = RestoreResult(drive.node, file or kind.value, kind.value)
     if kind is FileKind.SEQUENCE:
-        table, writes = _validated_sequence_writes(drive, path)
+        table, writes = _validated_sequence_writes(drive, text)
     else:
-        writes = [(var, _entry_value(var, entry.value)) for entry, var, _ in validate_object_file(drive, path)]
+        checked = validate_object_text(drive, text, Path(file).name if file else kind.value)
+        writes = [(var, _entry_value(var, entry.value)) for entry, var, _ in checked]
     _check_can_store(drive, store)
     if cancel is not None and cancel.requested:
         result.outcomes = [ObjectOutcome(var.label, _shown(value), "not written") for var, value in writes]
@@ -365,7 +427,7 @@ def _check_can_store(drive: Drive, store: bool) -> None:
     if store and drive.profile.save_needs_disabled:
         state = decode_state(int(drive.read("statusword").raw))
         if state is State.OPERATION_ENABLED:
-            raise BackupError(
+            raise DriveNotDisabled(
                 f"node {drive.node}: {drive.profile.device} stores parameters only with the drive "
                 "disabled; disable it first — nothing was written"
             )
@@ -398,7 +460,7 @@ def _write_and_verify(
             cancel,
         )
         link_error: SdoError | None = None
-        for index, outcome in zip(pending, written):
+        for index, outcome in zip(pending, written, strict=True):
             if isinstance(outcome, CancelledError):
                 continue  # dropped (cancelled, or the drive stopped answering) before it was sent: "not written"
             if isinstance(outcome, SdoAbortError):
@@ -423,7 +485,7 @@ def _write_and_verify(
             cancel,
         )
         mismatched = []
-        for index, outcome in zip(readable, read_back):
+        for index, outcome in zip(readable, read_back, strict=True):
             if isinstance(outcome, CancelledError):
                 continue
             if isinstance(outcome, SdoAbortError):
@@ -449,11 +511,11 @@ def _write_and_verify(
             break
 
 
-def _wait_batch(batch: TransferBatch, cancel: Cancellation | None) -> list[object]:
+def _wait_batch(batch: TransferBatch[T], cancel: Cancellation | None) -> list[T | Exception]:
     """The outcomes of a batch; a cancellation meanwhile drops its transfers not yet sent."""
     forget = cancel.on_cancel(batch.cancel) if cancel is not None else None
     try:
-        return batch.future.result()
+        return batch.outcomes()
     finally:
         if forget is not None:
             forget()
@@ -477,8 +539,10 @@ def _cancelled(drive: Drive, outcomes: dict[int, ObjectOutcome]) -> Cancelled:
 
 
 def _same(read: object, written: object) -> bool:
-    if isinstance(read, float) or isinstance(written, float):
-        return abs(float(read) - float(written)) <= 1e-6 * max(1.0, abs(float(written)))
+    """The value read back is the one written (a REAL to its precision, text without the drive's NUL padding)."""
+    floats = isinstance(read, float) or isinstance(written, float)
+    if floats and isinstance(read, int | float) and isinstance(written, int | float):
+        return abs(read - written) <= 1e-6 * max(1.0, abs(written))
     if isinstance(read, str) and isinstance(written, str):
         return read.rstrip("\0") == written
     return read == written
@@ -494,18 +558,19 @@ def _read_sequences(drive: Drive, progress: Progress | None) -> SequenceTable:
     number_var, type_var = drive.variable("sequence_number"), drive.variable((0x3611, 1))
     reporter = _Reporter(progress, "backup", drive.node, FileKind.SEQUENCE.value, count)
     types: dict[int, Future] = {}
-    for number in range(count):  # per-node FIFO: each read sees the number selected just before it
-        drive.submit_write(number_var, number)
-        types[number] = drive.submit_read(type_var)
+    for number in range(count):  # per-node FIFO (bulk lane): each read sees the number selected just before it
+        drive.submit_write(number_var, number, bulk=True)
+        types[number] = drive.submit_read(type_var, bulk=True)
     records: dict[int, dict[int, Future]] = {}
+    assert drive.dictionary is not None  # drive.variable above refused a drive without one
     try:
-        used = [number for number, future in types.items() if future.result().raw != 0]
+        used = [number for number, future in types.items() if settle(future).raw != 0]
         subs = sorted(sub for sub in drive.dictionary.object(0x3611).subs if sub >= 1)
         for number in used:
-            drive.submit_write(number_var, number)
-            records[number] = {sub: drive.submit_read(drive.variable((0x3611, sub))) for sub in subs}
+            drive.submit_write(number_var, number, bulk=True)
+            records[number] = {sub: drive.submit_read(drive.variable((0x3611, sub)), bulk=True) for sub in subs}
         values = {
-            number: {sub: int(future.result().raw) for sub, future in record.items()}
+            number: {sub: int(settle(future).raw) for sub, future in record.items()}
             for number, record in records.items()
         }
     except SdoError as error:
@@ -517,20 +582,19 @@ def _read_sequences(drive: Drive, progress: Progress | None) -> SequenceTable:
         raise BackupError(f"node {drive.node}: {error}") from None
 
 
-def _validated_sequence_writes(drive: Drive, path: Path) -> tuple[SequenceTable, list[tuple[Variable, object]]]:
+def _validated_sequence_writes(drive: Drive, text: str) -> tuple[SequenceTable, list[tuple[Variable, object]]]:
     count = int(drive.read("max_sequences").raw)
+    name = FileKind.SEQUENCE.value
     try:
-        table = read_sequence_file(path, max_sequences=count)
+        table = parse_sequence_text(text, name, max_sequences=count)
     except SequenceFileError as error:
         raise RestoreValidationError(f"{error} — nothing was written to node {drive.node}") from None
-    except OSError as error:
-        raise RestoreValidationError(f"{path}: {error.strerror}") from None
-    writes = []
+    writes: list[tuple[Variable, object]] = []
     for write in table.to_object_writes(clear_below=count):
         try:
             variable, raw, _ = drive.prepare_write((write.index, write.sub), write.value)
         except DriveAccessError as error:
-            raise RestoreValidationError(f"{path}: {error} — nothing was written") from None
+            raise RestoreValidationError(f"{name}: {error} — nothing was written") from None
         writes.append((variable, raw))
     return table, writes
 
@@ -539,12 +603,12 @@ def _write_sequences(
     drive: Drive, table: SequenceTable, writes: list[tuple[Variable, object]], progress: Progress | None
 ) -> list[ObjectOutcome]:
     """Write the whole sequence memory (LOAD semantics), then read it back and compare sequence by sequence."""
-    futures = [drive.submit_write(variable, value) for variable, value in writes]
+    futures = [drive.submit_write(variable, value, bulk=True) for variable, value in writes]
     reporter = _Reporter(progress, "restore", drive.node, FileKind.SEQUENCE.value, len(futures))
     _wait_all(futures, reporter)
     for future in futures:
         try:
-            future.result()
+            settle(future, 0)  # _wait_all waited already: each is done, or overdue
         except SdoAbortError as error:
             raise BackupError(f"node {drive.node}: sequence memory refused a write: {error}") from None
     memory = _read_sequences(drive, None)

@@ -13,9 +13,9 @@ import threading
 
 from servostudio.drive.access import Drive
 from servostudio.drive.cia402 import Command, State
-from servostudio.drive.control import StateChangeError, set_state
-from servostudio.drive.link import LinkDownError
-from servostudio.drive.sdo import SdoError
+from servostudio.drive.control import set_state
+from servostudio.drive.object_values import ObjectValue
+from servostudio.errors import RefusedForSafety, ServoStudioError
 from servostudio.services.bus import ConnectionManager
 
 log = logging.getLogger(__name__)
@@ -26,7 +26,7 @@ Axis = tuple[str, int]  # (bus id, node)
 _COMMAND_MASK = 0x8F
 
 
-class NoLiveClient(PermissionError):
+class NoLiveClient(RefusedForSafety, PermissionError):
     """Motion was asked for without a connected client to answer for it."""
 
 
@@ -54,13 +54,29 @@ class MotionGuard:
                 axes.discard(axis)
             self._owned[client].add(axis)
 
+    def write(
+        self, client: str | None, axis: Axis, drive: Drive, key: str, value: object, physical: bool = False
+    ) -> ObjectValue:
+        """Write one object of an axis: the way every object write of the server goes (REST, terminal), so a
+        control word that enables operation cannot pass without `client`."""
+        self.check_controlword_write(client, axis, drive, key, value)
+        return drive.write(key, value, physical)
+
+    def change_state(self, client: str | None, axis: Axis, drive: Drive, target: State) -> None:
+        """Walk the axis to `target`: enabling claims it for `client` (refused without one), any other target
+        releases it."""
+        if target is State.OPERATION_ENABLED:
+            self.claim(client, axis)
+        else:
+            self.release(axis)
+        set_state(drive, target)
+
     def check_controlword_write(self, client: str | None, axis: Axis, drive: Drive, key: str, value: object) -> None:
         """A raw write that enables operation is motion like any other: claim the axis for `client` (or refuse)."""
         if not drive.profile.has("controlword") or drive.variable(key).key != drive.profile.address("controlword"):
             return
-        try:
-            controlword = int(value, 0) if isinstance(value, str) else int(value)
-        except (TypeError, ValueError):
+        controlword = _integer(value)
+        if controlword is None:
             return  # not a number: the write itself refuses it with the dictionary's message
         if controlword & _COMMAND_MASK == Command.ENABLE_OPERATION:
             self.claim(client, axis)
@@ -93,5 +109,19 @@ class MotionGuard:
             try:
                 set_state(manager.get(bus).drive(node), State.QUICK_STOP_ACTIVE)
                 log.warning("client %s went away: quick stop of node %d on bus %s", client, node, bus)
-            except (LookupError, StateChangeError, SdoError, LinkDownError, ValueError) as error:
+            except ServoStudioError as error:
                 log.error("client %s went away: quick stop of node %d on bus %s failed: %s", client, node, bus, error)
+            except Exception:  # a bug must not leave the other axes running
+                log.exception("client %s went away: quick stop of node %d on bus %s failed", client, node, bus)
+
+
+def _integer(value: object) -> int | None:
+    """A control word as the caller spelled it (number or decimal/0x text); None when it is no integer."""
+    try:
+        if isinstance(value, str):
+            return int(value, 0)
+        if isinstance(value, int | float):
+            return int(value)
+    except (ValueError, OverflowError):
+        pass
+    return None

@@ -11,8 +11,10 @@ reported as node n+64.
 from __future__ import annotations
 
 from concurrent.futures import Future
+from typing import Any
 
-from servostudio.drive.sdo import SdoAbortError, SdoError
+from servostudio.drive.sdo import SdoAbortError, SdoError, SdoLinkError, settle
+from servostudio.errors import NotFound, Timeout, Unavailable
 from servostudio.od.datatypes import DataType, decode
 from servostudio.services.bus.connections import BusConnection, NodeInfo
 
@@ -31,8 +33,30 @@ _IDENTITY = {
 }
 
 
+class NoAnswer(Timeout):
+    """No node answered on the bus, or not the node asked for."""
+
+
+class UnknownDevice(NotFound):
+    """The node identified itself as a device no dictionary of the EDS library describes."""
+
+
+class ScanInterrupted(Unavailable):
+    """The bus went down or was closed during the scan; what the scan knew before is kept."""
+
+
 def scan(connection: BusConnection, nodes: range | list[int] | None = None) -> list[NodeInfo]:
-    """Probe, identify and remember the nodes present among ``nodes`` (default: every node ID)."""
+    """Probe, identify and remember the nodes present among ``nodes`` (default: every node ID).
+
+    A bus lost or closed meanwhile ends the scan with `ScanInterrupted` at once: silence on a dead link says
+    nothing about the nodes, so the nodes known before are kept."""
+    try:
+        return _scan(connection, nodes)
+    except SdoLinkError as error:
+        raise ScanInterrupted(f"scan of bus {connection.id} stopped: {error.reason}") from None
+
+
+def _scan(connection: BusConnection, nodes: range | list[int] | None) -> list[NodeInfo]:
     serial = connection.spec.kind == "serial"
     candidates = list(nodes) if nodes is not None else list(range(1, 64 if serial else 128))
     timeout = SERIAL_PROBE_TIMEOUT if serial else PROBE_TIMEOUT
@@ -72,12 +96,25 @@ def identify(connection: BusConnection, node: int) -> NodeInfo | None:
     return info
 
 
+def identified(connection: BusConnection, node: int) -> NodeInfo:
+    """Identify a node that must answer and be a device of the library (the node a command names)."""
+    info = identify(connection, node)
+    if info is None:
+        raise NoAnswer(f"node {node} does not answer on {connection.spec}")
+    if info.device is None:
+        raise UnknownDevice(
+            f"node {node} (vendor 0x{info.vendor_id or 0:X}, product 0x{info.product_code or 0:X}) "
+            "matches no dictionary of the EDS library; name its device"
+        )
+    return info
+
+
 def _identify(connection: BusConnection, node: int, device_type: object) -> NodeInfo:
     requests = {
         name: (connection.engine.upload(node, index, sub), data_type)
         for name, (index, sub, data_type) in _IDENTITY.items()
     }
-    values = {name: _value(future, data_type) for name, (future, data_type) in requests.items()}
+    values: dict[str, Any] = {name: _value(future, data_type) for name, (future, data_type) in requests.items()}
     info = NodeInfo(node=node, device_type=device_type if isinstance(device_type, int) else None, **values)
     if info.vendor_id is not None:
         info.device = connection.library.match(info.vendor_id, info.product_code or 0)
@@ -99,9 +136,11 @@ def _statusword_pdo(connection: BusConnection, node: int) -> int | None:
 
 
 def _answered(future: Future) -> bool:
-    """A node is present when it answered at all — an abort is an answer too."""
+    """A node is present when it answered at all — an abort is an answer too; a dead link answers nothing (raised)."""
     try:
-        future.result()
+        settle(future)
+    except SdoLinkError:
+        raise
     except SdoAbortError:
         return True
     except SdoError:
@@ -109,9 +148,11 @@ def _answered(future: Future) -> bool:
     return True
 
 
-def _value(future: Future, data_type: DataType) -> int | str | None:
+def _value(future: Future, data_type: DataType) -> int | float | str | bytes | None:
     try:
-        raw = future.result()
+        raw = settle(future)
+    except SdoLinkError:
+        raise
     except SdoError:
         return None
     size = data_type.size

@@ -10,17 +10,16 @@ from __future__ import annotations
 from concurrent.futures import Future
 from dataclasses import dataclass
 
-from servostudio.drive.access import Drive, DriveAccessError
-from servostudio.drive.sdo import SdoError
+from servostudio.drive.access import Drive
+from servostudio.errors import InvalidInput, ServoStudioError
 from servostudio.services.bus.connections import ConnectionManager
-from servostudio.services.motion import MotionGuard
 
 MAX_AXES = 4
 MAX_ITEMS = 32
 MIN_PERIOD = 0.05
 
 
-class TerminalError(ValueError):
+class TerminalError(InvalidInput):
     """A watch list the terminal refuses (too many axes, unknown bus/object)."""
 
 
@@ -53,38 +52,20 @@ def sample(manager: ConnectionManager, watch: Watch, timeout: float = 2.0) -> li
         try:
             drive = manager.get(item.bus).drive(item.node)
             pending.append((item, drive.submit_read(drive.variable(item.object)), ""))
-        except (LookupError, DriveAccessError) as error:
+        except ServoStudioError as error:
             pending.append((item, None, str(error)))
     rows = []
-    for item, future, error in pending:
+    for item, future, refusal in pending:
         row: dict[str, object] = {"bus": item.bus, "node": item.node, "object": item.object}
         if future is None:
-            row["error"] = error
+            row["error"] = refusal
         else:
             try:
                 row["value"] = future.result(timeout).as_dict()
-            except (SdoError, ValueError, TimeoutError) as failure:
+            except (ServoStudioError, ValueError, TimeoutError) as failure:
                 row["error"] = str(failure)
         rows.append(row)
     return rows
-
-
-def write(
-    manager: ConnectionManager,
-    motion: MotionGuard,
-    client: str | None,
-    bus: str,
-    node: int,
-    key: str,
-    value: object,
-    physical: bool = False,
-) -> dict[str, object]:
-    """Write one object (checked against the dictionary first) and return what was written.
-
-    A control word that enables operation needs the caller's live motion client, as on the REST route."""
-    drive = manager.get(bus).drive(node)
-    motion.check_controlword_write(client, (bus, node), drive, key, value)
-    return drive.write(key, value, physical).as_dict()
 
 
 def read_objects(drive: Drive, keys: list[str], timeout: float = 5.0) -> list[dict[str, object]]:
@@ -93,15 +74,15 @@ def read_objects(drive: Drive, keys: list[str], timeout: float = 5.0) -> list[di
     for key in keys:
         try:
             pending.append((key, drive.submit_read(drive.variable(key)), ""))
-        except DriveAccessError as error:
+        except ServoStudioError as error:
             pending.append((key, None, str(error)))
     rows = []
-    for key, future, error in pending:
-        row: dict[str, object] = {"object": key, "value": None, "error": error or None}
+    for key, future, refusal in pending:
+        row: dict[str, object] = {"object": key, "value": None, "error": refusal or None}
         if future is not None:
             try:
                 row["value"] = future.result(timeout).as_dict()
-            except (SdoError, ValueError, TimeoutError) as failure:
+            except (ServoStudioError, ValueError, TimeoutError) as failure:
                 row["error"] = str(failure)
         rows.append(row)
     return rows

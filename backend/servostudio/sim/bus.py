@@ -77,6 +77,6 @@ class VirtualBus:
 def _priority(frame: Frame) -> int:
     """Arbitration key, lower wins: the identifier bits as sent, then the RTR bit (recessive = 1)."""
     if frame.extended:
-        # Base identifier first; SRR and IDE are recessive, so a standard frame beats an extended one with the same base.
+        # Base identifier first; SRR and IDE are recessive: a standard frame beats an extended one of the same base.
         return (frame.can_id >> 18) << 21 | 0b11 << 19 | (frame.can_id & 0x3FFFF) << 1 | frame.rtr
     return frame.can_id << 21 | frame.rtr << 20

@@ -14,6 +14,7 @@ from collections.abc import Callable
 
 from servostudio.sim.frame import Frame
 from servostudio.sim.objects import ObjectStore
+from servostudio.sim.sequences import SequenceMemory
 
 ERROR_REGISTER = 0x1001
 PREDEFINED_ERROR_FIELD = 0x1003
@@ -48,7 +49,7 @@ class DriveEvents:
         self.flash_busy = False
         """True while the node writes or reads its flash files: the behaviour shows it as status word bit 15."""
         self.emergencies_sent = 0
-        self.sequences = None
+        self.sequences: SequenceMemory | None = None
         """The node's `SequenceMemory` (XtrapulsPac sequence mode) or None: the drive model reads sequences here."""
 
     @property

@@ -3,10 +3,11 @@
 
 Signatures are 4 ASCII characters read as a little-endian U32 (CiA 301: "save" = 0x65766173, "load" = 0x64616F6C);
 XtrapulsPac adds "lusr" (apply USER_PAR.TXT), "sseq" (sequence memory -> SEQUENCE.TXT), "lseq" (SEQUENCE.TXT
-replaces the sequence memory) and "mseq" (SEQUENCE.TXT merged into it). DRIVEPAR.TXT holds every object whose save type is DRIVEPAR. While an
-operation runs (`OPERATION_TIME`) `events.flash_busy` is set, which the drive behaviour shows as status word bit 15;
-with 0x205D bit 5 (save) / bit 4 (load) the SDO confirmation waits for the end of the operation. Reading the
-signature object returns the procedure status of decisions.md §4 (0 never executed … 4 error, 5 done).
+replaces the sequence memory) and "mseq" (SEQUENCE.TXT merged into it). DRIVEPAR.TXT holds every object whose save
+type is DRIVEPAR. While an operation runs (`OPERATION_TIME`) `events.flash_busy` is set, which the drive behaviour
+shows as status word bit 15; with 0x205D bit 5 (save) / bit 4 (load) the SDO confirmation waits for the end of the
+operation. Reading the signature object returns the procedure status of decisions.md §4 (0 never executed … 4 error,
+5 done).
 
 Files live in `<state dir>/node<N>/`; without a state directory they live in memory (they still survive an NMT
 reset, not the end of the process). A file with an unknown object or an impossible value is refused as a whole
@@ -146,7 +147,7 @@ class FlashFiles:
     def save_sequences(self) -> bool:
         """sseq: sequence memory -> SEQUENCE.TXT; error 44 when a slot cannot be written as a file."""
         try:
-            text = format_sequence_table(self.sequences.table(), f"{SEQUENCE} of node {self.store.node_id}")
+            text = format_sequence_table(self._sequence_memory().table(), f"{SEQUENCE} of node {self.store.node_id}")
         except ValueError as exc:
             return self._failed(SEQUENCE, str(exc))
         self.write_text(SEQUENCE, text)
@@ -158,11 +159,18 @@ class FlashFiles:
         text = self.read_text(SEQUENCE)
         if text is None:
             return not required or self._failed(SEQUENCE, f"{SEQUENCE} does not exist")
+        memory = self._sequence_memory()
         try:
-            self.sequences.take(parse_sequence_text(text, SEQUENCE, max_sequences=self.sequences.capacity), mode)
+            memory.take(parse_sequence_text(text, SEQUENCE, max_sequences=memory.capacity), mode)
         except (SequenceFileError, ValueError) as exc:
             return self._failed(SEQUENCE, str(exc))
         return True
+
+    def _sequence_memory(self) -> SequenceMemory:
+        """The sequence memory: the sequence operations are offered only on a device that has one."""
+        if self.sequences is None:
+            raise RuntimeError(f"node {self.store.node_id} has no sequence memory")
+        return self.sequences
 
     def _failed(self, name: str, reason: str) -> bool:
         self.last_error = reason

@@ -20,6 +20,7 @@ second thread, which on a loaded host costs more than the frame itself.
 
 from __future__ import annotations
 
+import contextlib
 import logging
 import select
 import socket
@@ -28,6 +29,7 @@ import time
 from collections import deque
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass
+from functools import partial
 from pathlib import Path
 
 from servostudio.od.library import EdsLibrary, builtin_library
@@ -137,7 +139,7 @@ class SimulatedNetwork:
                 dictionaries[spec.device],
                 self.clock,
                 self.bus,
-                lambda store, events, spec=spec: factory(spec.device, spec.node_id, store, events),
+                partial(factory, spec.device, spec.node_id),
                 state_dir=state_dir,
                 sdo_response_time=sdo_response_time,
             )
@@ -189,10 +191,10 @@ class SimulatedNetwork:
         if self.running:
             return
         self._stop.clear()
-        self._wake_pair = socket.socketpair()
-        for end in self._wake_pair:
+        pair = self._wake_pair = socket.socketpair()
+        for end in pair:
             end.setblocking(False)
-        self._thread = threading.Thread(target=self._run, name="sim-clock", daemon=True)
+        self._thread = threading.Thread(target=self._run, args=(pair[0],), name="sim-clock", daemon=True)
         self._thread.start()
 
     def stop(self) -> None:
@@ -208,7 +210,8 @@ class SimulatedNetwork:
         with self.lock:
             self._run_posted()  # frames that arrived while the thread was ending
 
-    def _run(self) -> None:
+    def _run(self, wake: socket.socket) -> None:
+        """The clock thread; `wake` is the read end of the wake-up pair, open until the thread has ended."""
         origin_wall = time.monotonic()
         origin_virtual = self.clock.now
         while not self._stop.is_set():
@@ -223,16 +226,16 @@ class SimulatedNetwork:
             if behind <= 0:  # until the next event, counted from now: running the chunk took time too
                 present = origin_virtual + (time.monotonic() - origin_wall)
                 wait = IDLE_WAIT if due is None else min(IDLE_WAIT, due - present)
-            self._wait_for_readers(max(wait, 0.0))
+            self._wait_for_readers(wake, max(wait, 0.0))
 
-    def _wait_for_readers(self, seconds: float) -> None:
+    def _wait_for_readers(self, wake: socket.socket, seconds: float) -> None:
         """Wait up to `seconds` for a watched socket or a wake-up, and serve what is readable. `select` waits to the
         microsecond; epoll and poll round up to whole milliseconds, longer than an SDO frame."""
-        wake = self._wake_pair[0]
-        readable, _, _ = select.select([wake, *self._readers], [], [], seconds)
+        watched: list[socket.socket | int] = [wake, *self._readers]
+        readable, _, _ = select.select(watched, [], [], seconds)
         for descriptor in readable:
             if descriptor is wake:
-                self._drain_wake()
+                self._drain_wake(wake)
             elif descriptor in self._readers:
                 self._readers[descriptor]()
 
@@ -313,14 +316,13 @@ class SimulatedNetwork:
         pair = self._wake_pair
         if pair is None:
             return
-        try:
+        with contextlib.suppress(BlockingIOError, OSError):  # plenty of wake-ups pending, or stopping: it wakes anyway
             pair[1].send(b"\0")
-        except (BlockingIOError, OSError):  # plenty of wake-ups pending, or stopping: the thread wakes anyway
-            pass
 
-    def _drain_wake(self) -> None:
+    @staticmethod
+    def _drain_wake(wake: socket.socket) -> None:
         try:
-            while self._wake_pair[0].recv(4096):
+            while wake.recv(4096):
                 pass
         except BlockingIOError:
             pass

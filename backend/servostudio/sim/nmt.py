@@ -8,7 +8,7 @@ NMT_COB_ID = 0x000
 HEARTBEAT_BASE = 0x700
 
 
-class NmtState(str, enum.Enum):
+class NmtState(enum.StrEnum):
     INITIALISING = "INITIALISING"
     PRE_OPERATIONAL = "PRE-OPERATIONAL"
     OPERATIONAL = "OPERATIONAL"

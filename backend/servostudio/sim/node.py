@@ -23,7 +23,7 @@ from pathlib import Path
 from typing import Protocol
 
 from servostudio.formats.sequence_model import LoadMode
-from servostudio.od.model import ObjectDictionary
+from servostudio.od.model import ObjectDictionary, Value
 from servostudio.sim.bus import VirtualBus
 from servostudio.sim.clock import VirtualClock
 from servostudio.sim.error_control import ErrorControl
@@ -146,7 +146,7 @@ class SimulatedNode:
 
     def _register_hooks(self) -> None:
         store = self.store
-        self._read_sync_cob_id = store.reader(SYNC_COB_ID, 0) if (SYNC_COB_ID, 0) in store else (lambda: 0x80)
+        self._read_sync_cob_id = store.integer_reader(SYNC_COB_ID, 0) if (SYNC_COB_ID, 0) in store else (lambda: 0x80)
         if (START_REMOTE_NODES, 0) in store:
             store.on_write(START_REMOTE_NODES, 0, self._start_remote_nodes)
         for index in (SYNC_COB_ID, SYNC_PERIOD):
@@ -287,7 +287,7 @@ class SimulatedNode:
             self.behaviour.on_nmt_reset()
         self._reset_communication()
 
-    def _start_remote_nodes(self, index: int, sub: int, value: object) -> None:
+    def _start_remote_nodes(self, index: int, sub: int, value: Value) -> None:
         """0x2000: 0 sends "enter pre-operational" to all nodes now, n sends "start" to all nodes after n ms."""
         delay_ms = int(value)
         command = NmtCommand.ENTER_PRE_OPERATIONAL if delay_ms == 0 else NmtCommand.START

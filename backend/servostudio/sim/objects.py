@@ -10,13 +10,14 @@ from __future__ import annotations
 
 from collections.abc import Callable, Iterable
 from functools import partial
+from typing import cast
 
 from servostudio.od.datatypes import DataType, EncodingError, decode, encode
 from servostudio.od.model import ObjectDictionary, Value, Variable
 from servostudio.sim import sdo_abort
 from servostudio.sim.sdo_abort import SdoAbort
 
-WriteHook = Callable[[int, int, Value], None]
+WriteHook = Callable[[int, int, Value], object]  # what a hook returns is ignored
 ReadHook = Callable[[int, int], Value]
 
 _FIRST_SDO_ACCESSIBLE = 0x1000  # 0x0001–0x0FFF are data type definitions / dummy mapping entries
@@ -38,7 +39,7 @@ def undefined_default(var: Variable) -> Value:
     to it when zero is outside LowLimit..HighLimit (a drive never holds a value it would refuse on the bus, so a
     backup of a fresh drive restores)."""
     value = zero_value(var.data_type)
-    if not var.data_type.is_numeric:
+    if not var.data_type.is_numeric or not isinstance(value, (int, float)):
         return value
     if var.minimum is not None and value < var.minimum:
         return var.minimum
@@ -96,6 +97,13 @@ class ObjectStore:
             raise KeyError(f"0x{index:04X},{sub} is not in the {self.od.device} dictionary")
         return partial(self._values.__getitem__, (index, sub))
 
+    def integer_reader(self, index: int, sub: int = 0) -> Callable[[], int]:
+        """`reader` of an object of an integer type (the control word, the SYNC COB-ID), which holds an int."""
+        var = self.od.get(index, sub)
+        if var is not None and not var.data_type.is_integer:
+            raise TypeError(f"{var.label} is a {var.data_type.name}, not an integer")
+        return cast(Callable[[], int], self.reader(index, sub))
+
     def set(self, index: int, sub: int, value: Value) -> None:
         key = (index, sub)
         if key not in self._values:
@@ -138,6 +146,14 @@ class ObjectStore:
         if hooks:
             return hooks[-1](var.index, var.subindex)
         return self._values[var.key]
+
+    def value_reader(self, var: Variable) -> Callable[[], Value]:
+        """A getter of what `read_value(var)` returns at the time of each call, its hook looked up once: for code
+        that samples an object every control period (the oscilloscope recorder)."""
+        hooks = self._read_hooks.get(var.key) or self._read_hooks.get((var.index, None))
+        if hooks:
+            return partial(hooks[-1], var.index, var.subindex)
+        return partial(self._values.__getitem__, var.key)
 
     def write_from_bus(self, index: int, sub: int, value: Value) -> None:
         var = self._accessible(index, sub)

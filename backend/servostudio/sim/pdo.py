@@ -5,7 +5,8 @@ on every NMT state change, so the defaults of the EDS are the default mappings. 
 - TPDO 1–240: every n-th SYNC; 0: at SYNC when the mapped data changed; 253: only on a remote request;
   254: XtrapulsPac "TPDO_Count" mode when the device has 0x23A0 (sent at SYNC when 0x23A0 == 0x23A1,n), otherwise
   like 255; 255: once on entering OPERATIONAL, then when the first mapped object changes (checked every control
-  period), and every event time (sub 5) when set. The inhibit time (sub 3, 100 µs units) is honoured when the dictionary has it.
+  period), and every event time (sub 5) when set. The inhibit time (sub 3, 100 µs units) is honoured when the
+  dictionary has it.
 - RPDO 0–240: the data is applied at the next SYNC; 254/255: applied on reception.
 Any valid TPDO answers a remote frame on its COB-ID. An RPDO shorter than its mapping raises EMCY 0x8210.
 """
@@ -16,7 +17,7 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 
 from servostudio.od.datatypes import decode, encode
-from servostudio.od.model import Variable
+from servostudio.od.model import Value, Variable
 from servostudio.sim import sdo_abort
 from servostudio.sim.clock import VirtualClock
 from servostudio.sim.frame import Frame
@@ -97,10 +98,10 @@ class PdoEngine:
     def _mark_dirty(self, index: int, sub: int, value: object) -> None:
         self._dirty = True
 
-    def _check_rpdo_mapping(self, index: int, sub: int, value: object) -> None:
+    def _check_rpdo_mapping(self, index: int, sub: int, value: Value) -> None:
         self._check_mapping(index, sub, int(value), receive=True)
 
-    def _check_tpdo_mapping(self, index: int, sub: int, value: object) -> None:
+    def _check_tpdo_mapping(self, index: int, sub: int, value: Value) -> None:
         self._check_mapping(index, sub, int(value), receive=False)
 
     def _check_mapping(self, index: int, sub: int, value: int, receive: bool) -> None:
@@ -241,11 +242,13 @@ class PdoEngine:
                 payload = self._payload(pdo)
                 if payload != pdo.last_payload:
                     self._send(pdo, payload)
-            elif kind == 254 and counter is not None:
-                if (TPDO_CONTROL, pdo.number + 1) in self.store and counter == self.store.get(
-                    TPDO_CONTROL, pdo.number + 1
-                ):
-                    self._send(pdo)
+            elif kind == 254 and counter is not None and self._count_reached(pdo, counter):
+                self._send(pdo)
+
+    def _count_reached(self, pdo: Pdo, counter: int) -> bool:
+        """TPDO_Count mode: the counter 0x23A0 equals this TPDO's entry of 0x23A1."""
+        control = (TPDO_CONTROL, pdo.number + 1)
+        return control in self.store and counter == self.store.get(*control)
 
     def poll(self) -> None:
         """Once per control period: event-driven TPDOs (first mapped object changed, or event timer)."""
@@ -269,8 +272,9 @@ class PdoEngine:
     def _payload(self, pdo: Pdo) -> bytes:
         payload, offset = 0, 0
         for entry in pdo.entries:
-            value = self.store.read_value(entry.variable)
-            payload |= _pack(entry.variable, value, entry.bits) << offset
+            var = entry.variable
+            if var is not None:  # always so: only an RPDO has dummy entries
+                payload |= _pack(var, self.store.read_value(var), entry.bits) << offset
             offset += entry.bits
         return payload.to_bytes(pdo.length, "little")
 
@@ -282,15 +286,15 @@ class PdoEngine:
         self._transmit(Frame(pdo.cob_id, payload))
 
 
-def _pack(var: Variable, value: object, bits: int) -> int:
+def _pack(var: Variable, value: Value, bits: int) -> int:
     raw = int.from_bytes(encode(var.data_type, value), "little")
     return raw & ((1 << bits) - 1)
 
 
-def _unpack(var: Variable, raw: int, bits: int) -> object:
+def _unpack(var: Variable, raw: int, bits: int) -> Value:
     data_type = var.data_type
     if data_type.is_integer:
         if data_type.is_signed and raw >> (bits - 1) & 1:
             raw -= 1 << bits  # two's complement, also for a shortened mapping (0x60C10110: 32-bit data as 16 bits)
         return raw
-    return decode(data_type, raw.to_bytes(data_type.bits // 8, "little"))
+    return decode(data_type, raw.to_bytes(data_type.fixed_size, "little"))

@@ -198,8 +198,8 @@ def _reachable_speed_rpm(torque_constant: float, dc_bus_voltage: float) -> int:
     return max(500, int(omega * 60.0 / (2 * math.pi) // 500 * 500))
 
 
-def _coerce(key: str, value: Any, annotation: str, source: str) -> Any:
-    """Check a JSON value against the field's declared type (annotations are strings here)."""
+def _coerce(key: str, value: Any, annotation: object, source: str) -> Any:
+    """Check a JSON value against the field's declared type (`dataclasses.Field.type`: a string here)."""
     text = str(annotation)
     if value is None and "None" in text:
         return None

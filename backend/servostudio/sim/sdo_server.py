@@ -12,6 +12,7 @@ import logging
 import struct
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from typing import TypeVar
 
 from servostudio.od.model import Variable
 from servostudio.sim import sdo_abort
@@ -19,6 +20,8 @@ from servostudio.sim.clock import Timer, VirtualClock
 from servostudio.sim.frame import Frame
 from servostudio.sim.objects import ObjectStore
 from servostudio.sim.sdo_abort import SdoAbort
+
+_T = TypeVar("_T")
 
 log = logging.getLogger(__name__)
 
@@ -168,7 +171,8 @@ class SdoServer:
             self._timeout.cancel()
             self._timeout = None
 
-    def _expect(self, kind: type) -> object:
+    def _expect(self, kind: type[_T]) -> _T:
+        """The transfer in progress when it is of `kind`, else the abort a client gets for a stray command."""
         if not isinstance(self._transfer, kind):
             raise SdoAbort(sdo_abort.INVALID_COMMAND, "no matching transfer in progress")
         self._arm_timeout()

@@ -15,6 +15,7 @@ Two endpoints carry the byte stream: a raw TCP server (pyserial `socket://HOST:P
 
 from __future__ import annotations
 
+import contextlib
 import os
 import queue
 import select
@@ -193,8 +194,6 @@ class SerialPty:
 
 
 def _close_socket(connection: socket.socket) -> None:
-    try:
+    with contextlib.suppress(OSError):
         connection.shutdown(socket.SHUT_RDWR)
-    except OSError:
-        pass
     connection.close()

@@ -11,6 +11,7 @@ python-can reads each handshake answer with a single `recv`, so bus frames start
 
 from __future__ import annotations
 
+import contextlib
 import queue
 import select
 import socket
@@ -109,10 +110,8 @@ class _Session:
         if self._attached:
             self.server.network.detach(self)
         self._output.put(None)
-        try:
+        with contextlib.suppress(OSError):
             self.connection.shutdown(socket.SHUT_RDWR)
-        except OSError:
-            pass
         self.server.network.unwatch_and_close(self.connection)
         self.server._forget(self)
 
@@ -168,7 +167,7 @@ class _Session:
             except BlockingIOError:
                 select.select([], [self.connection], [], WRITE_POLL)
                 if self._closed.is_set():
-                    raise OSError("session closed")
+                    raise OSError("session closed") from None
 
     def _on_readable(self) -> None:
         try:

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from importlib.metadata import PackageNotFoundError, metadata
+
 import can
 
 from servostudio.transport.socketcand import SocketcandBus
@@ -16,5 +18,22 @@ def open_bus(spec: BusSpec) -> can.BusABC:
         return SocketcandBus(channel=spec.channel, host=spec.host, port=spec.port)
     try:
         return can.Bus(**spec.python_can_config())
-    except (OSError, ImportError, ValueError) as error:
+    except can.CanInterfaceNotImplementedError as error:
+        raise can.CanInitializationError(f"cannot open {spec}: {error}{_install_hint(spec.kind)}") from error
+    except (OSError, ImportError, ValueError, TypeError, NameError) as error:
+        # python-can's backends report a missing vendor library or a wrong option in any of these
         raise can.CanInitializationError(f"cannot open {spec}: {error}") from error
+
+
+#: python-can extras named differently from their interface
+_EXTRA_OF = {"udp_multicast": "multicast", "gs_usb": "gs-usb"}
+
+
+def _install_hint(kind: str) -> str:
+    """Name the optional package that brings an interface's driver, when python-can declares one."""
+    extra = _EXTRA_OF.get(kind, kind)
+    try:
+        extras = metadata("python-can").get_all("Provides-Extra") or []
+    except PackageNotFoundError:
+        return ""
+    return f' (its driver package is missing: pip install "python-can[{extra}]")' if extra in extras else ""

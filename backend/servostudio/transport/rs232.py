@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import time
 from collections import deque
+from typing import Any
 
 import can
 import serial
@@ -52,7 +53,7 @@ def link_to_host(cob_id: int) -> int:
 class RS232Bus(can.BusABC):
     """python-can bus over the 12-byte ``'M'``/``'S'`` frames of the XtrapulsPac serial port."""
 
-    def __init__(self, channel: str, baudrate: int = 19200, cable_node: int | None = None, **kwargs: object) -> None:
+    def __init__(self, channel: str, baudrate: int = 19200, cable_node: int | None = None, **kwargs: Any) -> None:
         try:
             self._port = serial.serial_for_url(
                 channel, baudrate=baudrate, bytesize=8, parity="N", stopbits=1, timeout=0.05, write_timeout=1.0

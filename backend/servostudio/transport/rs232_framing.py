@@ -17,7 +17,7 @@ MAX_COB_ID = 0x7FF
 _ID_FLAG = 0x80
 
 
-def _checksum(body: bytes) -> int:
+def _checksum(body: bytes | bytearray) -> int:
     """XOR of the identifier and data bytes (frame bytes 1..10)."""
     value = 0
     for byte in body:

@@ -19,6 +19,7 @@ import select
 import socket
 import time
 from collections import deque
+from typing import Any
 
 import can
 
@@ -34,7 +35,7 @@ Frame = tuple[int, bytes, float, bool]
 class SocketcandBus(can.BusABC):
     """python-can bus over a socketcand server in raw mode."""
 
-    def __init__(self, channel: str, host: str, port: int, **kwargs: object) -> None:
+    def __init__(self, channel: str, host: str, port: int, **kwargs: Any) -> None:
         try:
             self._socket = socket.create_connection((host, port), timeout=CONNECT_TIMEOUT)
         except OSError as error:

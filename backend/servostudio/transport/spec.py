@@ -3,27 +3,49 @@
 ``socketcan:can0``, ``pcan:PCAN_USBBUS1@1000000``, ``ixxat:0@500000``, ``kvaser:0``,
 ``slcan:/dev/ttyACM0@1000000``, ``socketcand:HOST:PORT[/CHANNEL]``, ``virtual:NAME``,
 ``serial:PORT_OR_URL[@BAUD]`` (the XtrapulsPac RS-232 link) and ``sim[:NODES]`` (simulated drives in
-this process, NODES as for ``servostudio sim``, e.g. ``1:xtrapulspac,2:cd1k``).  A spec is what the user types on
-the command line and what the REST API takes, so the parser names the problem precisely.
+this process, NODES as for ``servostudio sim``, e.g. ``1:xtrapulspac,2:cd1k``).  Any other interface python-can
+knows — its built-in backends and the plugins installed beside it (``gs_usb:``, ``udp_multicast:``, ``vector:``,
+…) — is spelled the same way, ``INTERFACE:CHANNEL[@BITRATE]``, and every kind takes the interface's own options
+as a query, ``?name=value&…`` (``gs_usb:canable@1M?index=0``).  The name ``serial`` is the XtrapulsPac link, so
+python-can's own generic ``serial`` interface is not offered.  A spec is what the user types on the command line
+and what the REST API takes, so the parser names the problem precisely.
 """
 
 from __future__ import annotations
 
 import re
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
+from typing import Any
 
-KINDS = ("socketcan", "pcan", "ixxat", "kvaser", "slcan", "socketcand", "virtual", "serial", "sim")
-_WITH_BITRATE = {"pcan", "ixxat", "kvaser", "slcan", "serial"}
+from can.interfaces import VALID_INTERFACES
+
+from servostudio.errors import InvalidInput
+
+#: kinds of our own; every other python-can interface is accepted as well (see ``known_kinds``)
+OWN_KINDS = ("socketcand", "serial", "sim")
+#: interfaces whose bit rate is set outside the program (``ip link``, the other process), so '@' would mislead
+_WITHOUT_BITRATE = {"socketcan", "socketcand", "virtual", "udp_multicast", "sim"}
 _INTEGER_CHANNEL = {"ixxat", "kvaser"}
 SERIAL_BAUDRATES = (9600, 19200, 38400, 57600, 115200)
 DEFAULT_SERIAL_BAUDRATE = 19200
 DEFAULT_SOCKETCAND_CHANNEL = "can0"
 DEFAULT_SIM_NODES = "1,2,3"
 _RATE = re.compile(r"^(\d+)([kKmM]?)$")
+_OPTION_NAME = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*$")
+#: python-can's own interface of that name is shadowed by ours (the RS-232 link plugin is reached as ``serial:``)
+_SHADOWED = {"serial", "servostudio_rs232"}
+
+
+def known_kinds() -> tuple[str, ...]:
+    """Every kind a spec may start with: ours and python-can's interfaces (built-in and installed plugins)."""
+    python_can = sorted(set(VALID_INTERFACES) - _SHADOWED - set(OWN_KINDS))
+    return (*OWN_KINDS, *python_can)
+
+
 _SIM_NODES = re.compile(r"^\d+(:[A-Za-z0-9_-]+)?(,\d+(:[A-Za-z0-9_-]+)?)*$")
 
 
-class BusSpecError(ValueError):
+class BusSpecError(InvalidInput):
     """A spec string that does not name a usable bus; the message says which part is wrong and why."""
 
 
@@ -36,8 +58,13 @@ class BusSpec:
     bitrate: int | None = None
     host: str = ""
     port: int = 0
+    #: the interface's own keyword options, in the order given (``?index=0&bus=1``)
+    options: tuple[tuple[str, str], ...] = ()
 
     def __str__(self) -> str:
+        return self._address() + _query(self.options)
+
+    def _address(self) -> str:
         if self.kind == "socketcand":
             return f"socketcand:{self.host}:{self.port}/{self.channel}"
         if self.kind == "sim":
@@ -45,10 +72,16 @@ class BusSpec:
         text = f"{self.kind}:{self.channel}"
         return f"{text}@{self.bitrate}" if self.bitrate is not None else text
 
-    def python_can_config(self) -> dict[str, object]:
-        """Keyword arguments for ``can.Bus(**config)``; not available for ``sim`` (opened in-process)."""
+    def python_can_config(self) -> dict[str, Any]:
+        """Keyword arguments for ``can.Bus(**config)``; not available for ``sim`` (opened in-process).
+
+        The values are ``Any`` because ``can.Bus`` takes its interface options as ``**kwargs: Any``.
+        """
         if self.kind == "sim":
             raise BusSpecError("the 'sim' bus is opened in-process, not through python-can")
+        return {**self._base_config(), **{name: _option_value(text) for name, text in self.options}}
+
+    def _base_config(self) -> dict[str, Any]:
         if self.kind == "socketcand":
             return {"interface": "socketcand", "host": self.host, "port": self.port, "channel": self.channel}
         if self.kind == "serial":
@@ -57,7 +90,7 @@ class BusSpec:
                 "channel": self.channel,
                 "baudrate": self.bitrate or DEFAULT_SERIAL_BAUDRATE,
             }
-        config: dict[str, object] = {"interface": self.kind, "channel": self.channel}
+        config: dict[str, Any] = {"interface": self.kind, "channel": self.channel}
         if self.kind in _INTEGER_CHANNEL:
             config["channel"] = int(self.channel)
         if self.bitrate is not None:
@@ -65,15 +98,41 @@ class BusSpec:
         return config
 
 
+def _query(options: tuple[tuple[str, str], ...]) -> str:
+    return "?" + "&".join(f"{name}={value}" for name, value in options) if options else ""
+
+
+def _option_value(text: str) -> int | float | bool | str:
+    """An option's Python value: python-can's interfaces take numbers and flags as such, not as text."""
+    lowered = text.lower()
+    if lowered in ("true", "false"):
+        return lowered == "true"
+    for convert in (int, float):
+        try:
+            return convert(text)
+        except ValueError:
+            continue
+    return text
+
+
 def parse_bus_spec(text: str) -> BusSpec:
     """Parse a bus spec string; raise BusSpecError naming the wrong part."""
     text = text.strip()
     kind, colon, rest = text.partition(":")
     kind = kind.lower()
-    if kind not in KINDS:
-        raise BusSpecError(f"bus {text!r}: unknown interface {kind!r}; expected one of {', '.join(KINDS)}")
+    if kind not in known_kinds():
+        raise BusSpecError(f"bus {text!r}: unknown interface {kind!r}; expected one of {', '.join(known_kinds())}")
+    if kind == "serial":  # a pyserial URL may carry a query of its own (rfc2217://HOST:PORT?logging=debug)
+        return _parse_address(text, kind, rest, bool(colon))
+    rest, options = _split_options(text, rest)
+    if options and kind == "sim":
+        raise BusSpecError(f"bus {text!r}: the simulated bus takes no options")
+    return replace(_parse_address(text, kind, rest, bool(colon)), options=options)
+
+
+def _parse_address(text: str, kind: str, rest: str, has_colon: bool) -> BusSpec:
     if kind == "sim":
-        return _parse_sim(text, rest if colon else DEFAULT_SIM_NODES)
+        return _parse_sim(text, rest if has_colon else DEFAULT_SIM_NODES)
     if not rest:
         raise BusSpecError(f"bus {text!r}: missing channel after '{kind}:'")
     if kind == "socketcand":
@@ -89,11 +148,27 @@ def parse_bus_spec(text: str) -> BusSpec:
     return BusSpec(kind=kind, channel=channel, bitrate=bitrate)
 
 
+def _split_options(text: str, rest: str) -> tuple[str, tuple[tuple[str, str], ...]]:
+    """``CHANNEL?a=1&b=x`` → (``CHANNEL``, options); a name must be a Python keyword-argument name."""
+    address, question, query = rest.partition("?")
+    if not question:
+        return rest, ()
+    options: list[tuple[str, str]] = []
+    for item in query.split("&"):
+        name, equals, value = item.partition("=")
+        if not equals or not _OPTION_NAME.match(name) or not value:
+            raise BusSpecError(f"bus {text!r}: option {item!r} must look like name=value")
+        if name in ("interface", "channel", "bitrate") or any(name == seen for seen, _ in options):
+            raise BusSpecError(f"bus {text!r}: option {name!r} is given twice or is part of the spec itself")
+        options.append((name, value))
+    return address, tuple(options)
+
+
 def _split_bitrate(text: str, kind: str, rest: str) -> tuple[str, int | None]:
     channel, at, rate = rest.rpartition("@")
     if not at:
         return rest, None
-    if kind not in _WITH_BITRATE:
+    if kind in _WITHOUT_BITRATE:
         raise BusSpecError(f"bus {text!r}: {kind} takes no '@bitrate' (set it on the interface itself)")
     match = _RATE.match(rate)
     if not match:

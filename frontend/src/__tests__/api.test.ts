@@ -15,13 +15,14 @@ describe("api", () => {
     await expect(getHealth(ok)).resolves.toEqual({ status: "ok", version: "1.2.3" });
   });
 
-  it("shows the server's message: plain detail, {error, message} and validation lists", async () => {
+  it("shows the server's message with its kind and class, and the problems of a malformed request", async () => {
     await expect(request("GET", "/x", undefined, answer({ detail: "0x60F9,2: 70000 above 65535" }, 422)))
       .rejects.toThrow("0x60F9,2: 70000 above 65535");
-    const conflict = request("PUT", "/x", {}, answer({ detail: { error: "ConflictError", message: "changed meanwhile" } }, 409));
-    await expect(conflict).rejects.toMatchObject({ status: 409, kind: "ConflictError", message: "changed meanwhile" });
-    await expect(request("POST", "/x", {}, answer({ detail: [{ loc: ["body", "name"], msg: "Field required" }] }, 422)))
-      .rejects.toThrow("name: Field required");
+    const conflict = request("PUT", "/x", {}, answer({ detail: "changed meanwhile", error: "ConflictError", kind: "conflict" }, 409));
+    await expect(conflict).rejects.toMatchObject({ status: 409, kind: "conflict", error: "ConflictError", message: "changed meanwhile" });
+    const malformed = answer({ detail: [{ loc: ["body", "name"], msg: "Field required" }], error: "RequestValidationError", kind: "invalid_input" }, 422);
+    await expect(request("POST", "/x", {}, malformed)).rejects.toMatchObject({ message: "name: Field required", kind: "invalid_input" });
+    await expect(request("GET", "/x", undefined, answer({}, 404))).rejects.toMatchObject({ message: "/x: HTTP 404", kind: "" });
     await expect(request("GET", "/x", undefined, answer({}, 404))).rejects.toBeInstanceOf(ApiError);
   });
 

@@ -1,5 +1,5 @@
 import { describe, expect, it } from "vitest";
-import { Scope, derive, effect, h, state } from "../lib/dom";
+import { Scope, batch, derive, effect, h, state, untrack } from "../lib/dom";
 
 describe("reactive DOM binding", () => {
   it("binds an attribute and a text child to a state", () => {
@@ -63,5 +63,77 @@ describe("reactive DOM binding", () => {
     busy.val = true;
     expect(button.disabled).toBe(true);
     expect(button.getAttribute("title")).toBe("busy");
+  });
+
+  it("stops the bindings, effects and derived states created in a scope when it is disposed", () => {
+    const value = state(1);
+    const scope = new Scope();
+    const seen: number[] = [];
+    const element = scope.run(() => {
+      const doubled = derive(() => value.val * 2);
+      effect(() => void seen.push(doubled.val));
+      return h("span", { title: () => `t${value.val}` }, () => `n=${value.val}`);
+    });
+    value.val = 2;
+    expect([element.textContent, element.title, seen]).toEqual(["n=2", "t2", [2, 4]]);
+    scope.dispose();
+    value.val = 3;
+    expect([element.textContent, element.title, seen]).toEqual(["n=2", "t2", [2, 4]]);
+  });
+
+  it("stops the bindings of a bound child's old content when the content is replaced", () => {
+    const page = state("a");
+    const label = state("x");
+    let reads = 0;
+    const element = h("div", null, () => {
+      const current = page.val;
+      return h("p", null, () => {
+        reads += 1;
+        return `${current}:${label.val}`;
+      });
+    });
+    expect(element.textContent).toBe("a:x");
+    page.val = "b";
+    reads = 0;
+    label.val = "y";
+    // Only the binding of the current content runs: the old <p>'s is stopped, not left for the collector.
+    expect(reads).toBe(1);
+    expect(element.textContent).toBe("b:y");
+  });
+
+  it("untrack reads without making the caller depend on what it read", () => {
+    const tracked = state(1);
+    const ignored = state(10);
+    let runs = 0;
+    const sum = derive(() => {
+      runs += 1;
+      return tracked.val + untrack(() => ignored.val);
+    });
+    ignored.val = 20;
+    expect([sum.val, runs]).toEqual([11, 1]);
+    tracked.val = 2;
+    expect([sum.val, runs]).toEqual([22, 2]);
+  });
+
+  it("batch runs each reader once, after all the changes", () => {
+    const a = state(1);
+    const b = state(2);
+    const seen: number[] = [];
+    effect(() => void seen.push(a.val + b.val));
+    batch(() => {
+      a.val = 10;
+      b.val = 20;
+      expect(seen).toEqual([3]);
+    });
+    expect(seen).toEqual([3, 30]);
+  });
+
+  it("selects a <select>'s bound value among its options, given after the value", () => {
+    const choice = state("b");
+    const select = h("select", { value: choice }, ["a", "b", "c"].map((value) => h("option", { value }, value)));
+    expect(select.value).toBe("b");
+    choice.val = "c";
+    expect(select.value).toBe("c");
+    expect(h("select", { value: "c" }, h("option", { value: "a" }), h("option", { value: "c" })).value).toBe("c");
   });
 });

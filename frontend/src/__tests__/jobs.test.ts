@@ -2,7 +2,7 @@ import { afterEach, describe, expect, it, vi } from "vitest";
 import { runJob, type JobInfo } from "../client/jobs";
 import { LiveHub } from "../client/live";
 
-const running = (id: string): JobInfo => ({ id, operation: "restore", state: "running", result: null, error: null });
+const running = (id: string): JobInfo => ({ id, operation: "restore", state: "running", result: null, error: null, started: 0 });
 
 /** Let the start request's promise chain run. */
 const settled = () => new Promise((resolve) => setTimeout(resolve, 0));

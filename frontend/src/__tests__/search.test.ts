@@ -16,7 +16,7 @@ function object(index: number, name: string, kind: string, subs: OdVariable[], g
 }
 
 const dictionary: Dictionary = {
-  device: "test", product_name: "Test", vendor_id: 1, product_code: 2, revision: 3, groups: ["General", "Servo Loops"],
+  device: "test", product_name: "Test", vendor_id: 1, product_code: 2, revision: 3, groups: ["General", "Servo Loops"], builtin: true, object_count: 8,
   objects: [
     object(0x6041, "Statusword", "VAR", [variable(0, "Statusword", { bits: [{ first: 3, last: 3, name: "Fault" }] })]),
     object(0x6060, "Modes of operation", "VAR", [variable(0, "Modes of operation", { enum: { "1": "Profile position" } })]),

@@ -1,43 +1,51 @@
 /** Typed access to the communication server's REST API (same origin). */
 
-import type { Dictionary, DictionarySummary, Scalar } from "../lib/od";
+import type { Dictionary, DictionarySummary } from "../lib/od";
+import type { Schemas } from "./schema-types";
 
-export interface Health {
-  status: string;
-  version: string;
-}
+export type Health = Schemas["Health"];
+export type UserInfo = Schemas["UserModel"];
 
-/** A refusal of the server, with its message (FastAPI `detail`, a `{error, message}` body, or a validation list). */
+export type ErrorBody = Schemas["ErrorBody"];
+export type ErrorKind = Schemas["ErrorKind"];
+
+/**
+ * A refusal of the server, with its message. The server answers `{detail, error, kind}` (`ErrorBody`): `detail` is
+ * the message (or the list of problems of a malformed request), `error` the exception class, `kind` what the caller
+ * can do about it. A body without them (a proxy's error page) leaves the path and the status.
+ */
 export class ApiError extends Error {
   constructor(
     readonly status: number,
     message: string,
-    readonly kind = "",
+    /** `not_found`, `invalid_input`, `conflict`, … ("" when the server did not say). */
+    readonly kind: ErrorKind | "" = "",
+    /** The server's exception class ("" when it did not say). */
+    readonly error = "",
   ) {
     super(message);
   }
 }
 
+/** The problems of a malformed request as one line: `name: Field required; node_id: …`. */
+function problemsText(problems: { loc?: unknown[]; msg?: string }[]): string {
+  return problems.map((item) => `${(item.loc ?? []).slice(1).join(".")}: ${item.msg ?? ""}`).join("; ");
+}
+
 export async function errorOf(path: string, response: Response): Promise<ApiError> {
-  let body: unknown = null;
+  let body: Partial<ErrorBody> | null = null;
   try {
-    body = await response.json();
+    body = (await response.json()) as Partial<ErrorBody>;
   } catch {
     // Not JSON (a proxy error page, say): the status line is all there is.
   }
-  const detail = (body as { detail?: unknown } | null)?.detail ?? body;
-  if (typeof detail === "string") return new ApiError(response.status, detail);
-  if (Array.isArray(detail)) {
-    const text = detail
-      .map((item: { loc?: unknown[]; msg?: string }) => `${(item.loc ?? []).slice(1).join(".")}: ${item.msg ?? ""}`)
-      .join("; ");
-    return new ApiError(response.status, text || `${path}: HTTP ${response.status}`);
-  }
-  if (detail && typeof detail === "object" && "message" in detail) {
-    const { message, error } = detail as { message: string; error?: string };
-    return new ApiError(response.status, message, error ?? "");
-  }
-  return new ApiError(response.status, `${path}: HTTP ${response.status}`);
+  const fallback = `${path}: HTTP ${response.status}`;
+  const detail: unknown = body?.detail;
+  const kind = body?.kind ?? "";
+  const error = body?.error ?? "";
+  if (typeof detail === "string") return new ApiError(response.status, detail, kind, error);
+  if (Array.isArray(detail)) return new ApiError(response.status, problemsText(detail) || fallback, kind, error);
+  return new ApiError(response.status, fallback, kind, error);
 }
 
 let motionClient: string | null = null;
@@ -85,8 +93,8 @@ export const patch = <T>(path: string, body: unknown) => request<T>("PATCH", pat
 export const del = <T>(path: string) => request<T>("DELETE", path);
 
 /** Who the server says we are (name and user level). */
-export function getMe(fetchImpl: typeof fetch = fetch): Promise<{ name: string; level: string }> {
-  return getJson<{ name: string; level: string }>("/api/me", fetchImpl);
+export function getMe(fetchImpl: typeof fetch = fetch): Promise<UserInfo> {
+  return getJson<UserInfo>("/api/me", fetchImpl);
 }
 
 export function getHealth(fetchImpl: typeof fetch = fetch): Promise<Health> {
@@ -121,91 +129,20 @@ export function importDictionary(eds: File, props: File | null): Promise<Diction
 
 // ---- projects ---------------------------------------------------------------------------------------------------
 
-export interface BusConfig {
-  name: string;
-  interface: string;
-  bitrate: number | null;
-}
-
-export interface AxisConfig {
-  name: string;
-  device: string;
-  node_id: number;
-  bus: string;
-  description: string;
-  motor: string;
-  application: string;
-}
-
-export interface Project {
-  name: string;
-  description: string;
-  buses: BusConfig[];
-  axes: AxisConfig[];
-  revision: string;
-}
-
-export interface ProjectSummary {
-  name: string;
-  description: string;
-  axis_count: number;
-  revision: string;
-}
-
-export interface ProjectParameter {
-  index: number;
-  subindex: number;
-  name: string;
-  group: string;
-  data_type: string;
-  access: string;
-  save_type: string;
-  unit: string;
-  value: Scalar;
-  default: Scalar;
-  differs_from_default: boolean;
-  file: string | null;
-  editable: boolean;
-  not_editable_reason: string | null;
-}
-
-export interface ParameterList {
-  parameters: ProjectParameter[];
-  revision: string;
-}
-
-export interface CompareRow {
-  index: number;
-  subindex: number;
-  name: string;
-  group: string;
-  unit: string;
-  values: Record<string, Scalar>;
-  differs: boolean;
-}
-
-export interface Motor {
-  reference: string;
-  description: string;
-  source: string;
-  motor_data: Record<string, number | string>;
-  objects: Record<string, number | string>;
-  builtin: boolean;
-}
-
-export interface AxisChoice {
-  changed: ProjectParameter[];
-  skipped: string[];
-  project: Project;
-}
-
-export interface Template {
-  key: string;
-  title: string;
-  description: string;
-  settings: { index: number; subindex: number; value: number; why: string }[];
-  groups: string[] | null;
-}
+// The payloads are the server's pydantic models (generated into schema.d.ts by `make api-types`).
+export type BusConfig = Schemas["BusModel"];
+export type AxisConfig = Schemas["AxisModel"];
+export type Project = Schemas["ProjectModel"];
+export type ProjectSummary = Schemas["ProjectSummary"];
+export type ProjectParameter = Schemas["ParameterModel"];
+export type ParameterList = Schemas["ParameterList"];
+export type CompareRow = Schemas["CompareRowModel"];
+export type Comparison = Schemas["CompareModel"];
+export type Motor = Schemas["MotorModel"];
+export type AxisChoice = Schemas["AxisChoiceModel"];
+export type Template = Schemas["TemplateModel"];
+type ProjectChange = Schemas["ProjectUpdate"];
+type AxisChange = Schemas["AxisUpdate"];
 
 /** The address form of the projects API: `0x60F9,2`. */
 export function projectAddress(index: number, subindex: number): string {
@@ -219,7 +156,7 @@ export const projects = {
   get: (name: string) => get<Project>(`/api/projects/${e(name)}`),
   create: (name: string, description: string, buses: BusConfig[]) =>
     post<Project>("/api/projects", { name, description, buses }),
-  update: (name: string, change: { description?: string; buses?: BusConfig[]; revision?: string }) =>
+  update: (name: string, change: ProjectChange) =>
     patch<Project>(`/api/projects/${e(name)}`, change),
   remove: (name: string, revision: string) => del<void>(`/api/projects/${e(name)}?revision=${e(revision)}`),
   rename: (name: string, newName: string, revision: string) =>
@@ -231,7 +168,7 @@ export const projects = {
       new Blob([archive], { type: "application/zip" })),
   addAxis: (project: string, axis: Omit<AxisConfig, "motor" | "application">, revision: string) =>
     post<Project>(`/api/projects/${e(project)}/axes`, { ...axis, revision }),
-  editAxis: (project: string, axis: string, change: Partial<AxisConfig> & { revision: string }) =>
+  editAxis: (project: string, axis: string, change: AxisChange) =>
     patch<Project>(axisPath(project, axis), change),
   removeAxis: (project: string, axis: string, revision: string) =>
     del<Project>(`${axisPath(project, axis)}?revision=${e(revision)}`),
@@ -242,7 +179,7 @@ export const projects = {
   resetParameters: (project: string, axis: string, addresses: string[], revision?: string) =>
     post<ParameterList>(`${axisPath(project, axis)}/parameters/reset`, { addresses, revision }),
   compare: (project: string, axis: string, onlyDifferences: boolean) =>
-    get<{ columns: string[]; rows: CompareRow[]; revision: string }>(
+    get<Comparison>(
       `${axisPath(project, axis)}/compare?only_differences=${onlyDifferences}`,
     ),
   selectMotor: (project: string, axis: string, reference: string, revision: string) =>

@@ -2,76 +2,19 @@
 
 import { get, post, put, request, projectAddress } from "./api";
 import type { Scalar } from "../lib/od";
+import { state, type State } from "../lib/dom";
+import type { Schemas } from "./schema-types";
 
 const e = encodeURIComponent;
 
-export interface NodeIdentity {
-  node: number;
-  device: string | null;
-  device_type: number | null;
-  vendor_id: number | null;
-  product_code: number | null;
-  revision: number | null;
-  serial_number: number | null;
-  device_name: string | null;
-  hardware_version: string | null;
-  software_version: string | null;
-}
-
-export interface BusInfo {
-  id: string;
-  spec: string;
-  kind: string;
-  connected: boolean;
-  error: string | null;
-  nodes: NodeIdentity[];
-}
-
-export interface ObjectValue {
-  node: number;
-  index: number;
-  sub: number;
-  name: string;
-  label: string;
-  data_type: string;
-  access: string;
-  raw: number | string;
-  physical: number | string;
-  unit: string;
-  text: string;
-  bits: { name: string; first: number; last: number; value: number }[];
-}
-
-export interface ReadResult {
-  object: string;
-  value: ObjectValue | null;
-  error: string | null;
-}
-
-export interface DriveStateInfo {
-  node: number;
-  state: string | null;
-  statusword: number;
-  nmt_state: string | null;
-}
-
-export interface FaultInfo {
-  code: number;
-  cia402_code: number;
-  name: string;
-  remedy: string;
-}
-
-export interface FaultReport {
-  node: number;
-  state: string | null;
-  statusword: number;
-  fault: boolean;
-  error_code: number;
-  error_text: string;
-  faults: FaultInfo[];
-  warnings: FaultInfo[];
-}
+// The payloads are the server's pydantic models (generated into schema.d.ts by `make api-types`).
+export type NodeIdentity = Schemas["NodeIdentity"];
+export type BusInfo = Schemas["BusStatus"];
+export type ObjectValue = Schemas["ObjectValueModel"];
+export type ReadResult = Schemas["ReadResult"];
+export type DriveStateInfo = Schemas["DriveState"];
+export type FaultInfo = Schemas["FaultInfoModel"];
+export type FaultReport = Schemas["FaultReportModel"];
 
 /** One value of a batch read, keyed like the dictionary. */
 export interface ReadValue {
@@ -85,29 +28,31 @@ const MAX_BATCH = 256;
 
 /**
  * Project bus name → the server's bus id. A project names its bus ("sim") and gives its spec; the server may have
- * opened that spec under another id ("bus0"). `setBuses` learns the mapping: same id first, else same spec.
+ * opened that spec under another id ("bus0"). `learnBuses` learns the mapping: same id first, else same spec. The
+ * mapping is a state, so a binding that shows `serverBus(…)` follows it.
  */
-const aliases = new Map<string, string>();
+const aliases: State<ReadonlyMap<string, string>> = state(new Map());
 let learned: () => void = () => undefined;
 /** Resolves once the mapping was learned (after the app loaded projects and buses); drive calls wait for it. */
 const aliasesKnown = new Promise<void>((resolve) => (learned = resolve));
 
 export function learnBuses(server: BusInfo[], projectBuses: { name: string; interface: string }[]): void {
   learned();
-  aliases.clear();
+  const next = new Map<string, string>();
   for (const bus of projectBuses) {
     const match = server.find((candidate) => candidate.id === bus.name) ?? server.find((candidate) => candidate.spec === bus.interface);
-    if (match) aliases.set(bus.name, match.id);
+    if (match) next.set(bus.name, match.id);
   }
+  aliases.val = next;
 }
 
 /** Names under which the UI knows a server bus: its id and every project bus mapped to it. */
 export function busNames(serverId: string): string[] {
-  return [serverId, ...[...aliases].filter(([name, id]) => id === serverId && name !== serverId).map(([name]) => name)];
+  return [serverId, ...[...aliases.rawVal].filter(([name, id]) => id === serverId && name !== serverId).map(([name]) => name)];
 }
 
 export function serverBus(bus: string): string {
-  return aliases.get(bus) ?? bus;
+  return aliases.val.get(bus) ?? bus;
 }
 
 const nodePath = (bus: string, node: number) => `/api/buses/${e(serverBus(bus))}/nodes/${node}`;
@@ -141,7 +86,7 @@ export const driveApi = {
       const results = await driveApi.readKeys(bus, node, chunk.map(([index, sub]) => projectAddress(index, sub)), signal);
       results.forEach((result, position) => {
         const [index, subindex] = chunk[position];
-        values.push({ index, subindex, raw: result.value ? result.value.raw : null, error: result.error });
+        values.push({ index, subindex, raw: result.value ? result.value.raw : null, error: result.error ?? null });
       });
     }
     return values;

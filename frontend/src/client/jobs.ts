@@ -6,14 +6,12 @@
 
 import { get, post } from "./api";
 import type { LiveEvent, LiveHub } from "./live";
+import type { Narrow, Schemas } from "./schema-types";
 
-export interface JobInfo<R = unknown> {
-  id: string;
-  operation: string;
-  state: "running" | "done" | "failed" | "cancelled";
-  result: R | null;
-  error: string | null;
-}
+export type JobState = "running" | "done" | "failed" | "cancelled";
+
+/** A server job (`JobModel`); its `result` depends on the operation, which the schema leaves open. */
+export type JobInfo<R = unknown> = Narrow<Schemas["JobModel"], { state: JobState; result?: R | null }>;
 
 /** While the event socket is down the job's end is polled at this period instead. */
 const POLL_MS = 2000;

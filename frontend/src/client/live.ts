@@ -1,13 +1,19 @@
 /**
  * Live state of buses and axes, fed by the server's event WebSocket (`/api/ws/events`). Pages subscribe to the
- * event types they show; the hub keeps the last known state of each axis for the project tree and the top bar.
+ * event types they show; the hub keeps the last known state of each axis, the buses and the user as reactive
+ * states (`lib/dom.ts`), so the project tree, the top bar and the pages bind to them instead of re-rendering.
  * While the socket is open the server watches the known drives' status words and sends `drive_state` on every
  * change, so axis states need no polling.
  */
 
-import { setMotionClient, type AxisConfig } from "./api";
+import { setMotionClient, type AxisConfig, type UserInfo } from "./api";
 import { busNames } from "./drives";
+import type { EventMap, EventType, LiveEvent } from "./messages";
 import { STATE_LABELS, decodeState, type DriveState } from "../lib/cia402";
+import { state, type State } from "../lib/dom";
+
+export type { LiveEvent } from "./messages";
+export type { UserInfo } from "./api";
 
 export interface AxisStatus {
   online: boolean;
@@ -23,15 +29,10 @@ export interface BusStatus {
   state: string;
 }
 
-export interface UserInfo {
-  name: string;
-  level: string;
-}
-
-export type LiveEvent = Record<string, unknown> & { type: string };
 type Listener = (event: LiveEvent) => void;
 
 const RECONNECT_MS = 2000;
+const UNKNOWN: AxisStatus = { online: false, nmt: null, state: null, statusword: null, fault: false, faultText: "" };
 
 export function axisKey(bus: string, node: number): string {
   return `${bus}:${node}`;
@@ -51,54 +52,66 @@ export function axisStateText(status: AxisStatus | undefined): { text: string; t
 export class LiveHub {
   private readonly listeners = new Map<string, Set<Listener>>();
   private readonly changeListeners = new Set<() => void>();
-  private readonly axes = new Map<string, AxisStatus>();
-  private readonly busStates = new Map<string, string>();
-  private currentUser: UserInfo | null = null;
+  /** One state per axis (created on first read, so a binding may read an axis before anything is known of it). */
+  private readonly axes = new Map<string, State<AxisStatus | undefined>>();
+  /** The server's buses and their state, for the top bar. */
+  readonly busStates: State<BusStatus[]> = state([]);
+  readonly userState: State<UserInfo | null> = state(null);
+  /** Whether the event socket is open: axis states and job ends then arrive as events, no polling needed. */
+  readonly socketOpen: State<boolean> = state(false);
   private watched: AxisConfig[] = [];
-  private socketOpen = false;
 
   start(): void {
     this.connect();
   }
 
-  /** Whether the event socket is open: axis states and job ends then arrive as events, no polling needed. */
   connected(): boolean {
-    return this.socketOpen;
+    return this.socketOpen.rawVal;
   }
 
   /** Subscribe to one event type ("*" for all); returns the unsubscribe function. */
+  on<K extends EventType>(type: K, listener: (event: EventMap[K]) => void): () => void;
+  on(type: string, listener: Listener): () => void;
   on(type: string, listener: Listener): () => void {
     let set = this.listeners.get(type);
     if (!set) this.listeners.set(type, (set = new Set()));
     set.add(listener);
-    return () => set!.delete(listener);
+    return () => set.delete(listener);
   }
 
+  /** Called after every change of an axis, the buses or the user (for code that does not bind to the states). */
   onChange(listener: () => void): () => void {
     this.changeListeners.add(listener);
     return () => this.changeListeners.delete(listener);
   }
 
+  /** The state of one axis; read inside a binding, the binding follows it. */
+  axisState(bus: string, node: number): State<AxisStatus | undefined> {
+    const key = axisKey(bus, node);
+    let slot = this.axes.get(key);
+    if (!slot) this.axes.set(key, (slot = state<AxisStatus | undefined>(undefined)));
+    return slot;
+  }
+
   axis(bus: string, node: number): AxisStatus | undefined {
-    return this.axes.get(axisKey(bus, node));
+    return this.axisState(bus, node).val;
   }
 
   buses(): BusStatus[] {
-    return [...this.busStates].map(([name, state]) => ({ name, state }));
+    return this.busStates.val;
   }
 
   user(): UserInfo | null {
-    return this.currentUser;
+    return this.userState.val;
   }
 
   setUser(user: UserInfo): void {
-    this.currentUser = user;
+    this.userState.val = user;
     this.changed();
   }
 
   setBuses(buses: BusStatus[]): void {
-    this.busStates.clear();
-    for (const bus of buses) this.busStates.set(bus.name, bus.state);
+    this.busStates.val = buses.map((bus) => ({ ...bus }));
     this.changed();
   }
 
@@ -110,15 +123,14 @@ export class LiveHub {
 
   /** Merge fresh knowledge about one axis (from a REST answer or an event). */
   updateAxis(bus: string, node: number, change: Partial<AxisStatus>): void {
-    const key = axisKey(bus, node);
-    const previous = this.axes.get(key) ?? { online: false, nmt: null, state: null, statusword: null, fault: false, faultText: "" };
-    const next = { ...previous, ...change };
+    const slot = this.axisState(bus, node);
+    const next = { ...(slot.rawVal ?? UNKNOWN), ...change };
     if (change.statusword !== undefined && change.statusword !== null) {
       next.state = decodeState(change.statusword);
       next.fault = next.state === "fault" || next.state === "fault_reaction_active";
       if (!next.fault) next.faultText = "";
     }
-    this.axes.set(key, next);
+    slot.val = next;
     this.changed();
   }
 
@@ -127,7 +139,7 @@ export class LiveHub {
   }
 
   refreshAxis = async (_axis: AxisConfig): Promise<void> => {
-    // Replaced in drives.ts once the drive routes are known (keeps this module free of REST details).
+    // Replaced by the app once the drive routes are known (keeps this module free of REST details).
   };
 
   private changed(): void {
@@ -138,7 +150,7 @@ export class LiveHub {
     const protocol = window.location.protocol === "https:" ? "wss:" : "ws:";
     const socket = new WebSocket(`${protocol}//${window.location.host}/api/ws/events`);
     socket.addEventListener("open", () => {
-      this.socketOpen = true;
+      this.socketOpen.val = true;
       void this.refreshAxes();
       this.emit({ type: "ws_open" });
     });
@@ -152,7 +164,7 @@ export class LiveHub {
       }
     });
     socket.addEventListener("close", () => {
-      this.socketOpen = false;
+      this.socketOpen.val = false;
       setMotionClient(null);
       setTimeout(() => this.connect(), RECONNECT_MS);
     });

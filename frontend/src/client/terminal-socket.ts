@@ -6,17 +6,9 @@
 
 import { getMotionClient } from "./api";
 import type { ObjectValue } from "./drives";
+import type { TerminalMessage, WatchItem, WatchRow } from "./messages";
 
-export interface WatchItem {
-  bus: string;
-  node: number;
-  object: string;
-}
-
-export interface WatchRow extends WatchItem {
-  value?: ObjectValue;
-  error?: string;
-}
+export type { WatchItem, WatchRow } from "./messages";
 
 type Pending = { resolve: (value: unknown) => void; reject: (error: Error) => void };
 
@@ -57,7 +49,7 @@ export class TerminalSocket {
   }
 
   private onMessage(text: string): void {
-    const message = JSON.parse(text) as { type: string; rows?: WatchRow[]; value?: ObjectValue; detail?: string };
+    const message = JSON.parse(text) as TerminalMessage;
     if (message.type === "values") {
       this.onRows?.(message.rows ?? []);
     } else if (message.type === "written") {

@@ -1,6 +1,23 @@
-/** Small shared widgets: toasts, modal dialogs, progress lines, a panel with a title. */
+/** Small shared widgets: toasts, modal dialogs and form dialogs, message lines, downloads and file pickers. */
 
-import { h } from "../lib/dom";
+import { h, state, type State } from "../lib/dom";
+
+/** A line of feedback under a toolbar or in a dialog; `testid` names it for the browser tests. */
+export interface Message {
+  text: string;
+  tone: "error" | "warn" | "ok";
+  testid?: string;
+}
+
+export const failure = (error: unknown, testid?: string): Message => ({ text: errorText(error), tone: "error", testid });
+
+/** The message of `message` (nothing while it is null). */
+export function messageView(message: State<Message | null>): HTMLElement {
+  return h("div", null, () => {
+    const current = message.val;
+    return current ? h("div", { class: `message ${current.tone}`, "data-testid": current.testid }, current.text) : null;
+  });
+}
 
 let toastArea: HTMLElement | null = null;
 
@@ -44,6 +61,37 @@ export function openDialog(title: string, onClose?: () => void): DialogHandle {
   document.addEventListener("keydown", onKey, true);
   document.body.append(overlay);
   return { close, body, actions };
+}
+
+export interface FormDialog {
+  title: string;
+  body: Node[];
+  confirm: string;
+  confirmTestid?: string;
+  /** Test id of the refusal shown in the dialog. */
+  errorTestid?: string;
+  disabled?: boolean;
+  /** Runs on the primary button; the dialog closes when it resolves, a refusal is shown in the dialog. */
+  submit(): Promise<void>;
+}
+
+/** A dialog with fields, Cancel and one primary button whose action may fail (the server's refusal is shown). */
+export function formDialog(form: FormDialog): DialogHandle & { error: State<Message | null>; submit(): Promise<void> } {
+  const dialog = openDialog(form.title);
+  const error = state<Message | null>(null);
+  const submit = async () => {
+    try {
+      error.val = null;
+      await form.submit();
+      dialog.close();
+    } catch (problem) {
+      error.val = failure(problem, form.errorTestid);
+    }
+  };
+  dialog.body.append(...form.body, messageView(error));
+  dialog.actions.append(h("button", { onclick: () => dialog.close() }, "Cancel"),
+    h("button", { class: "primary", "data-testid": form.confirmTestid, disabled: form.disabled ?? false, onclick: () => void submit() }, form.confirm));
+  return { ...dialog, error, submit };
 }
 
 /** Ask before something irreversible (restore, delete, enabling power). Resolves true on confirmation. */

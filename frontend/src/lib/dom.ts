@@ -9,9 +9,14 @@
  * - `h(tag, attrs, ...children)` — an element; an attribute value or a child may be a `State` or a function
  *   (`() => value`), which binds it: the attribute or the child node follows the states the function read.
  *
- * Bindings hold their DOM node weakly: once a page's element is dropped and collected, its bindings stop.
- * An `effect` (and a `derive` on a state that outlives the page, such as the live hub's) must be stopped by the
- * page's `dispose`; `Scope` collects those stops.
+ * - `untrack(fn)` — run `fn` without making the states it reads dependencies of the caller.
+ * - `batch(fn)` — set several states; their readers run once, when `fn` returns.
+ *
+ * Ownership: bindings, effects and derived states created while a `Scope` runs (`scope.run(fn)`,
+ * `scope.effect(fn)`) are stopped by its `dispose` — a page builds its element in its scope and disposes it in
+ * `dispose`. A bound child owns what its content creates: when the content is replaced, the bindings of the
+ * old content stop at once. Bindings also hold their DOM node weakly, so those made outside any scope stop once
+ * their element is dropped and collected.
  */
 
 export type Child = Node | string | number | null | undefined | false | Child[];
@@ -22,6 +27,11 @@ type Listener = () => void;
 
 /** The reader currently being tracked: every state read while it runs becomes one of its dependencies. */
 let tracking: Set<StateImpl<unknown>> | null = null;
+/** The scope that owns the bindings, effects and derived states created now (see `Scope.run`). */
+let owner: Scope | null = null;
+/** Inside `batch`: readers to run when the outermost batch ends, in the order they were first notified. */
+let batchDepth = 0;
+const pending = new Set<Listener>();
 
 export interface State<T> {
   val: T;
@@ -45,7 +55,8 @@ class StateImpl<T> implements State<T> {
   set val(next: T) {
     if (Object.is(next, this.current)) return;
     this.current = next;
-    for (const listener of [...this.listeners]) listener();
+    if (batchDepth > 0) for (const listener of this.listeners) pending.add(listener);
+    else for (const listener of [...this.listeners]) listener();
   }
 
   get rawVal(): T {
@@ -82,7 +93,15 @@ function track<T>(compute: () => T, changed: (value: T) => void): { first: T; st
     }
   };
   const listener = () => {
-    if (!stopped) changed(run());
+    if (stopped) return;
+    // A re-run belongs to no scope: what it creates is owned by its own bound child, if any.
+    const previousOwner = owner;
+    owner = null;
+    try {
+      changed(run());
+    } finally {
+      owner = previousOwner;
+    }
   };
   const stop = () => {
     stopped = true;
@@ -95,24 +114,71 @@ function track<T>(compute: () => T, changed: (value: T) => void): { first: T; st
 /** A state computed from other states. */
 export function derive<T>(compute: () => T): State<T> {
   let derived: StateImpl<T> | null = null;
-  const { first } = track(compute, (value) => {
+  const { first, stop } = track(compute, (value) => {
     if (derived) derived.val = value;
   });
+  owner?.add(stop);
   derived = new StateImpl(first);
   return derived;
 }
 
 /** Run `fn` now and again whenever a state it read changes, until the returned function is called. */
 export function effect(fn: () => void): () => void {
-  return track(fn, () => undefined).stop;
+  const { stop } = track(fn, () => undefined);
+  owner?.add(stop);
+  return stop;
 }
 
-/** Stops of effects and subscriptions that end with a page (`dispose`). */
+/** Run `fn` without tracking: the states it reads do not become dependencies of the binding that calls it. */
+export function untrack<T>(fn: () => T): T {
+  const previous = tracking;
+  tracking = null;
+  try {
+    return fn();
+  } finally {
+    tracking = previous;
+  }
+}
+
+/** Run `fn`, which sets several states; each reader of them runs once, after `fn`, instead of once per change. */
+export function batch<T>(fn: () => T): T {
+  batchDepth += 1;
+  try {
+    return fn();
+  } finally {
+    batchDepth -= 1;
+    if (batchDepth === 0) {
+      while (pending.size > 0) {
+        const listeners = [...pending];
+        pending.clear();
+        for (const listener of listeners) listener();
+      }
+    }
+  }
+}
+
+/**
+ * Stops of the bindings, effects and subscriptions that end together — with a page (`dispose`), a bound child's
+ * content, or a set of rows.
+ */
 export class Scope {
   private readonly stops: (() => void)[] = [];
 
+  /** Run `fn` with this scope as the owner of the bindings, effects and derived states it creates. */
+  run<T>(fn: () => T): T {
+    const previous = owner;
+    // The owner is module state by design (what `h` creates registers in it), not an alias for `this`.
+    // eslint-disable-next-line @typescript-eslint/no-this-alias
+    owner = this;
+    try {
+      return fn();
+    } finally {
+      owner = previous;
+    }
+  }
+
   effect(fn: () => void): void {
-    this.stops.push(effect(fn));
+    this.run(() => effect(fn));
   }
 
   /** Register any other clean-up (an interval, a socket, a hub subscription). */
@@ -134,15 +200,20 @@ export function valueOf<T>(value: Bindable<T>): T {
 
 /**
  * Bind `read` to `node`: `apply` runs now and on every change while `node` is alive (held weakly, so a
- * dropped page's bindings end with its elements).
+ * dropped page's bindings end with its elements) and until the owning scope is disposed.
  */
-function bind<T>(node: Node, read: () => T, apply: (target: Node, value: T) => void): void {
+function bind<T>(node: Node, read: () => T, apply: (target: Node, value: T) => void, onStop?: () => void): void {
   const ref = new WeakRef(node);
   const { first, stop } = track(read, (value) => {
     const target = ref.deref();
     if (target) apply(target, value);
-    else stop();
+    else end();
   });
+  const end = () => {
+    stop();
+    onStop?.();
+  };
+  owner?.add(end);
   apply(node, first);
 }
 
@@ -185,8 +256,10 @@ export function h<K extends keyof HTMLElementTagNameMap>(
   ...children: (Child | Bindable<Child>)[]
 ): HTMLElementTagNameMap[K] {
   const element = document.createElement(tag);
-  if (attrs) for (const [key, value] of Object.entries(attrs)) applyAttribute(element, key, value);
+  if (attrs) for (const [key, value] of Object.entries(attrs)) if (key !== "value") applyAttribute(element, key, value);
   append(element, children);
+  // After the children: a <select>'s value can only pick one of its options once they are there.
+  if (attrs && "value" in attrs) applyAttribute(element, "value", attrs.value);
   return element;
 }
 
@@ -198,19 +271,28 @@ function toNodes(child: Child): Node[] {
 
 /**
  * A bound child: the nodes between two empty text markers are replaced whenever the states read by `read`
- * change (a list, an optional part, a text).
+ * change (a list, an optional part, a text). Each content is built in its own scope, disposed when the content
+ * is replaced. Both markers are held weakly (a strong reference to one would keep the whole element alive).
  */
 function boundChild(read: () => Child): DocumentFragment {
   const start = document.createTextNode("");
   const end = document.createTextNode("");
+  const endRef = new WeakRef(end);
   const fragment = document.createDocumentFragment();
   fragment.append(start, end);
-  bind(start, read, (marker, child) => {
+  let content: Scope | null = null;
+  const build = (): Child => {
+    content?.dispose();
+    content = new Scope();
+    return content.run(read);
+  };
+  bind(start, build, (marker, child) => {
     const parent = marker.parentNode;
-    if (!parent) return;
-    while (marker.nextSibling && marker.nextSibling !== end) parent.removeChild(marker.nextSibling);
-    for (const node of toNodes(child)) parent.insertBefore(node, end);
-  });
+    const last = endRef.deref();
+    if (!parent || !last) return;
+    while (marker.nextSibling && marker.nextSibling !== last) parent.removeChild(marker.nextSibling);
+    for (const node of toNodes(child)) parent.insertBefore(node, last);
+  }, () => content?.dispose());
   return fragment;
 }
 

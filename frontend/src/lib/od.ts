@@ -1,58 +1,15 @@
 /** The object dictionary as the server sends it (`GET /api/dictionaries/{device}`), plus helpers over it. */
 
-import type { BitField } from "./bits";
+import type { Schemas } from "../client/schema-types";
 import { formatHex } from "./numbers";
 
 export type Scalar = number | string | null;
 
-export interface OdVariable {
-  subindex: number;
-  name: string;
-  data_type: string;
-  access: string;
-  pdo_mappable: boolean;
-  low: number | null;
-  high: number | null;
-  default: Scalar;
-  unit: string;
-  scale: number;
-  offset: number;
-  save_type: string;
-  group: string;
-  description: string;
-  enum: Record<string, string>;
-  bits: BitField[];
-  is_pointer: boolean;
-  reference: string;
-}
-
-export interface OdObject {
-  index: number;
-  name: string;
-  kind: string;
-  group: string;
-  subs: OdVariable[];
-}
-
-export interface Dictionary {
-  device: string;
-  product_name: string;
-  vendor_id: number;
-  product_code: number;
-  revision: number;
-  groups: string[];
-  objects: OdObject[];
-}
-
-export interface DictionarySummary {
-  device: string;
-  product_name: string;
-  vendor_id: number;
-  product_code: number;
-  revision: number;
-  object_count: number;
-  builtin: boolean;
-}
+// The dictionary's payloads are the server's pydantic models (generated into schema.d.ts by `make api-types`).
+export type OdVariable = Schemas["EntryModel"];
+export type OdObject = Schemas["ObjectModel"];
+export type Dictionary = Schemas["DictionaryModel"];
+export type DictionarySummary = Schemas["DictionarySummary"];
 
 /** One (index, sub) together with its object: the unit the parameter editor lists, edits and searches. */
 export interface Entry {

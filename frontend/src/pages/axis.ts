@@ -2,7 +2,7 @@
 
 import type { Page, PageContext } from "../app";
 import { getDictionary, projects, type AxisConfig, type Project } from "../client/api";
-import { h } from "../lib/dom";
+import { h, Scope } from "../lib/dom";
 import type { Dictionary } from "../lib/od";
 import { buildPath, type AxisView } from "../lib/router";
 import { axisStateText } from "../client/live";
@@ -49,13 +49,13 @@ export async function axisPage(context: PageContext, projectName: string, axisNa
       : view === "commissioning" ? commissioningView(axisContext)
         : backupView(axisContext));
 
-  const state = h("span", { class: "pill", "data-testid": "axis-live-state" });
-  const drawState = () => {
-    const text = axisStateText(context.app.live.axis(axis.bus, axis.node_id));
-    state.replaceChildren(h("span", { class: `dot ${text.tone}` }), text.text);
-  };
-  drawState();
-  const unsubscribe = context.app.live.onChange(drawState);
+  // The header follows the live hub, which outlives the page: its binding is stopped with the page's scope.
+  const scope = new Scope();
+  const status = context.app.live.axisState(axis.bus, axis.node_id);
+  const state = scope.run(() => h("span", { class: "pill", "data-testid": "axis-live-state" }, () => {
+    const text = axisStateText(status.val);
+    return [h("span", { class: `dot ${text.tone}` }), text.text];
+  }));
   const tabs = h("nav", { class: "tabs" }, VIEWS.map(([key, label, keys]) => h("a", {
     href: buildPath({ page: "axis", project: project.name, axis: axis.name, view: key }),
     class: key === view ? "active" : "", title: `${label} (${keys})`, "data-testid": `tab-${key}`,
@@ -73,7 +73,7 @@ export async function axisPage(context: PageContext, projectName: string, axisNa
     update: viewPage.update,
     focusSearch: viewPage.focusSearch,
     dispose: () => {
-      unsubscribe();
+      scope.dispose();
       viewPage.dispose?.();
     },
   };

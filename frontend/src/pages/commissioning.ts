@@ -1,121 +1,157 @@
 /** Commissioning checklist of one axis in the manual's order; each step links to the page or group that does it. */
 
-import { projects, type Template } from "../client/api";
-import { errorText, openDialog, toast } from "../components/ui";
-import { STEPS, stepKeys, stepStatus, type Step } from "../lib/commissioning";
-import { h, replaceChildren } from "../lib/dom";
+import { projects, type AxisConfig, type Template } from "../client/api";
+import { errorText, formDialog, toast } from "../components/ui";
+import { loader, type Loaded } from "../lib/async";
+import { STEPS, stepKeys, stepStatus, type Step, type StepStatus } from "../lib/commissioning";
+import { h, Scope, state, type State } from "../lib/dom";
 import { formatHex } from "../lib/numbers";
 import { buildPath } from "../lib/router";
 import type { AxisContext, AxisViewPage } from "./axis";
 
 const TICKS_KEY = "servostudio.commissioning";
 
+/** Step key → when the user ticked it (ISO time). */
 type Ticks = Record<string, string>;
 
+interface ChecklistView {
+  context: AxisContext;
+  axis: State<AxisConfig>;
+  /** The entries the project files set (`index.sub`), loaded again when the axis changes. */
+  explicit: State<Loaded<Set<string>>>;
+  ticks: State<Ticks>;
+}
+
 export async function commissioningView(context: AxisContext): Promise<AxisViewPage> {
-  const { project, dictionary, page } = context;
-  let axis = context.axis;
-  const list = h("ol", { class: "steps", "data-testid": "checklist" });
-  const summary = h("span", { class: "muted", "data-testid": "checklist-summary" });
-  const tickKey = `${project.name}/${axis.name}`;
-  const ticks = (): Ticks => (JSON.parse(localStorage.getItem(TICKS_KEY) ?? "{}") as Record<string, Ticks>)[tickKey] ?? {};
-  const setTick = (step: string, on: boolean) => {
-    const all = JSON.parse(localStorage.getItem(TICKS_KEY) ?? "{}") as Record<string, Ticks>;
-    const mine = all[tickKey] ?? {};
-    if (on) mine[step] = new Date().toISOString();
-    else delete mine[step];
-    all[tickKey] = mine;
-    localStorage.setItem(TICKS_KEY, JSON.stringify(all));
-  };
-
-  const templateDialog = async () => {
-    const templates: Template[] = await projects.templates(axis.device);
-    const dialog = openDialog("Drive configuration: application template");
-    const select = h("select", { "data-testid": "template-select" }, templates.map((t) => h("option", { value: t.key }, t.title)));
-    if (axis.application) select.value = axis.application;
-    const text = h("div", { class: "muted" });
-    const message = h("div");
-    const describe = () => {
-      const chosen = templates.find((t) => t.key === select.value);
-      replaceChildren(text, chosen ? [chosen.description, chosen.settings.length ? h("ul", null, chosen.settings.map((s) =>
-        h("li", null, `${formatHex(s.index)}.${s.subindex} = ${s.value}: ${s.why}`))) : ""] : "");
-    };
-    select.addEventListener("change", describe);
-    describe();
-    dialog.body.append(templates.length ? h("label", { class: "field" }, "Template", select) : h("div", { class: "message warn" }, `No template is defined for ${dictionary.product_name}.`), text, message);
-    dialog.actions.append(h("button", { onclick: () => dialog.close() }, "Cancel"), h("button", {
-      class: "primary", disabled: templates.length === 0, "data-testid": "template-apply", onclick: async () => {
-        try {
-          const fresh = await projects.get(project.name);
-          const choice = await projects.applyApplication(project.name, axis.name, select.value, fresh.revision);
-          page.app.updateProject(choice.project);
-          axis = choice.project.axes.find((a) => a.name === axis.name) ?? axis;
-          dialog.close();
-          toast(`Template applied: ${choice.changed.length} values set in the project`, "ok");
-          await render();
-        } catch (error) {
-          replaceChildren(message, h("div", { class: "message error" }, errorText(error)));
-        }
-      },
-    }, "Apply to project"));
-  };
-
-  const link = (step: Step): Node => {
-    const view = (target: "dashboard" | "backup" | "parameters", label: string, query: Record<string, string> = {}) =>
-      h("a", { class: "button", href: buildPath({ page: "axis", project: project.name, axis: axis.name, view: target }, query) }, label);
-    const firstObject = step.objects.map((o) => dictionary.objects.find((d) => d.index === o.index)).find(Boolean);
-    const parameters = firstObject ? view("parameters", "Parameters", { group: firstObject.group }) : null;
-    switch (step.page) {
-      case "template":
-        return h("span", { class: "toolbar" }, h("button", { "data-testid": "open-template", onclick: () => void templateDialog() }, "Choose template…"));
-      case "motors":
-        return h("span", { class: "toolbar" }, h("a", { class: "button", href: "/motors" }, "Motor catalog"), parameters);
-      case "dashboard":
-        return h("span", { class: "toolbar" }, view("dashboard", "Dashboard"), parameters);
-      case "backup":
-        return h("span", { class: "toolbar" }, view("backup", "Backup / store"));
-      default:
-        return parameters ?? h("span", { class: "muted" }, "—");
-    }
-  };
-
-  const render = async () => {
-    let explicit = new Set<string>();
-    try {
-      const rows = (await projects.parameters(project.name, axis.name)).parameters;
-      explicit = new Set(rows.filter((row) => row.file !== null).map((row) => `${row.index}.${row.subindex}`));
-    } catch (error) {
-      replaceChildren(list, h("li", null, h("span", { class: "error-text" }, errorText(error))));
-      return;
-    }
-    const ticked = ticks();
-    let done = 0;
-    let applicable = 0;
-    replaceChildren(list, STEPS.map((step, position) => {
-      const keys = stepKeys(step, dictionary);
-      const extra = step.key === "config" ? Boolean(axis.application) : step.key === "motor" ? Boolean(axis.motor) : false;
-      const status = stepStatus(step, keys, explicit, Boolean(ticked[step.key]), extra);
-      if (status.state !== "not-applicable") applicable++;
-      if (status.state === "done") done++;
-      const detail = step.key === "config" && axis.application ? `template "${axis.application}"`
-        : step.key === "motor" && axis.motor ? `motor ${axis.motor}${status.total ? ` · ${status.set} of ${status.total} values set` : ""}`
-          : status.state === "not-applicable" ? `not in the ${dictionary.product_name} dictionary`
-            : status.total ? `${status.set} of ${status.total} values set in the project` : "";
-      const tickBox = step.manual ? h("label", { class: "check", title: "Tick when done (remembered in this browser)" },
-        h("input", { type: "checkbox", checked: Boolean(ticked[step.key]), "data-testid": `tick-${step.key}`, onchange: (event: Event) => { setTick(step.key, (event.target as HTMLInputElement).checked); void render(); } }),
-        ticked[step.key] ? `done ${ticked[step.key].slice(0, 16).replace("T", " ")}` : "done") : null;
-      return h("li", { class: status.state, "data-testid": `step-${step.key}`, "data-state": status.state },
-        h("span", { class: "mark" }, status.state === "done" ? "✓" : String(position + 1)),
-        h("div", null, h("strong", null, step.title), h("div", { class: "checks" }, detail)),
-        h("div", { class: "muted" }, step.summary, tickBox ? [" ", tickBox] : null),
-        link(step));
-    }));
-    summary.textContent = `${done} of ${applicable} steps done`;
-  };
-  await render();
+  const scope = new Scope();
+  const axis = state(context.axis);
+  const tickKey = `${context.project.name}/${context.axis.name}`;
+  const ticks = state(readTicks()[tickKey] ?? {});
+  scope.effect(() => saveTicks(tickKey, ticks.val));
+  const explicit = loader(scope, () => axis.val, async (current) => {
+    const rows = (await projects.parameters(context.project.name, current.name)).parameters;
+    return new Set(rows.filter((row) => row.file !== null).map((row) => `${row.index}.${row.subindex}`));
+  });
+  const view: ChecklistView = { context, axis, explicit, ticks };
   return {
-    element: h("div", { class: "page" },
-      h("div", { class: "toolbar" }, h("strong", null, "Commissioning order (manual §1.8)"), summary),
-      h("div", { class: "panel" }, list)),
+    dispose: () => scope.dispose(),
+    element: scope.run(() => h("div", { class: "page" },
+      h("div", { class: "toolbar" }, h("strong", null, "Commissioning order (manual §1.8)"),
+        h("span", { class: "muted", "data-testid": "checklist-summary" }, () => summary(view))),
+      h("div", { class: "panel" }, h("ol", { class: "steps", "data-testid": "checklist" }, () => checklist(view))))),
   };
+}
+
+function readTicks(): Record<string, Ticks> {
+  return JSON.parse(localStorage.getItem(TICKS_KEY) ?? "{}") as Record<string, Ticks>;
+}
+
+function saveTicks(tickKey: string, ticks: Ticks): void {
+  localStorage.setItem(TICKS_KEY, JSON.stringify({ ...readTicks(), [tickKey]: ticks }));
+}
+
+/** Each step's status from the project files, the axis's template and motor, and the user's ticks. */
+function statuses(view: ChecklistView, explicit: Set<string>): StepStatus[] {
+  const axis = view.axis.val;
+  const ticks = view.ticks.val;
+  return STEPS.map((step) => {
+    const extra = step.key === "config" ? Boolean(axis.application) : step.key === "motor" ? Boolean(axis.motor) : false;
+    return stepStatus(step, stepKeys(step, view.context.dictionary), explicit, Boolean(ticks[step.key]), extra);
+  });
+}
+
+function summary(view: ChecklistView): string {
+  const loaded = view.explicit.val;
+  if (loaded.status !== "ready") return "";
+  const all = statuses(view, loaded.value);
+  return `${all.filter((s) => s.state === "done").length} of ${all.filter((s) => s.state !== "not-applicable").length} steps done`;
+}
+
+function checklist(view: ChecklistView): Node[] | Node | null {
+  const loaded = view.explicit.val;
+  if (loaded.status === "loading") return null;
+  if (loaded.status === "failed") return h("li", null, h("span", { class: "error-text" }, errorText(loaded.error)));
+  const all = statuses(view, loaded.value);
+  return STEPS.map((step, position) => stepItem(view, step, position, all[position]));
+}
+
+function stepDetail(view: ChecklistView, step: Step, status: StepStatus): string {
+  const axis = view.axis.val;
+  if (step.key === "config" && axis.application) return `template "${axis.application}"`;
+  if (step.key === "motor" && axis.motor) return `motor ${axis.motor}${status.total ? ` · ${status.set} of ${status.total} values set` : ""}`;
+  if (status.state === "not-applicable") return `not in the ${view.context.dictionary.product_name} dictionary`;
+  return status.total ? `${status.set} of ${status.total} values set in the project` : "";
+}
+
+function stepItem(view: ChecklistView, step: Step, position: number, status: StepStatus): HTMLElement {
+  const ticked = view.ticks.val[step.key];
+  const tick = (on: boolean) => {
+    const next = { ...view.ticks.rawVal };
+    if (on) next[step.key] = new Date().toISOString();
+    else delete next[step.key];
+    view.ticks.val = next;
+  };
+  const tickBox = step.manual ? h("label", { class: "check", title: "Tick when done (remembered in this browser)" },
+    h("input", { type: "checkbox", checked: Boolean(ticked), "data-testid": `tick-${step.key}`, onchange: (event: Event) => tick((event.target as HTMLInputElement).checked) }),
+    ticked ? `done ${ticked.slice(0, 16).replace("T", " ")}` : "done") : null;
+  return h("li", { class: status.state, "data-testid": `step-${step.key}`, "data-state": status.state },
+    h("span", { class: "mark" }, status.state === "done" ? "✓" : String(position + 1)),
+    h("div", null, h("strong", null, step.title), h("div", { class: "checks" }, stepDetail(view, step, status))),
+    h("div", { class: "muted" }, step.summary, tickBox ? [" ", tickBox] : null),
+    stepLink(view, step));
+}
+
+/** Where the step is done: the template dialog, the motor catalog, the dashboard, backup, or its parameter group. */
+function stepLink(view: ChecklistView, step: Step): Node {
+  const { project, dictionary } = view.context;
+  const axis = view.axis.val;
+  const page = (target: "dashboard" | "backup" | "parameters", label: string, query: Record<string, string> = {}) =>
+    h("a", { class: "button", href: buildPath({ page: "axis", project: project.name, axis: axis.name, view: target }, query) }, label);
+  const firstObject = step.objects.map((o) => dictionary.objects.find((d) => d.index === o.index)).find(Boolean);
+  const parameters = firstObject ? page("parameters", "Parameters", { group: firstObject.group }) : null;
+  switch (step.page) {
+    case "template":
+      return h("span", { class: "toolbar" }, h("button", { "data-testid": "open-template", onclick: () => void templateDialog(view) }, "Choose template…"));
+    case "motors":
+      return h("span", { class: "toolbar" }, h("a", { class: "button", href: "/motors" }, "Motor catalog"), parameters);
+    case "dashboard":
+      return h("span", { class: "toolbar" }, page("dashboard", "Dashboard"), parameters);
+    case "backup":
+      return h("span", { class: "toolbar" }, page("backup", "Backup / store"));
+    default:
+      return parameters ?? h("span", { class: "muted" }, "—");
+  }
+}
+
+/** Choose the axis's application template (the settings each makes are listed) and apply it to the project. */
+async function templateDialog(view: ChecklistView): Promise<void> {
+  const { project, dictionary, page } = view.context;
+  const axis = view.axis.rawVal;
+  const templates: Template[] = await projects.templates(axis.device);
+  const chosen = state("");
+  const select = h("select", { "data-testid": "template-select", onchange: () => (chosen.val = select.value) },
+    templates.map((t) => h("option", { value: t.key }, t.title)));
+  if (axis.application) select.value = axis.application;
+  chosen.val = select.value;
+  const text = h("div", { class: "muted" }, () => templateText(templates.find((t) => t.key === chosen.val)));
+  formDialog({
+    title: "Drive configuration: application template",
+    body: [templates.length ? h("label", { class: "field" }, "Template", select) : h("div", { class: "message warn" }, `No template is defined for ${dictionary.product_name}.`), text],
+    confirm: "Apply to project",
+    confirmTestid: "template-apply",
+    disabled: templates.length === 0,
+    submit: async () => {
+      const fresh = await projects.get(project.name);
+      const choice = await projects.applyApplication(project.name, axis.name, select.value, fresh.revision);
+      page.app.updateProject(choice.project);
+      view.axis.val = choice.project.axes.find((a) => a.name === axis.name) ?? axis;
+      toast(`Template applied: ${choice.changed.length} values set in the project`, "ok");
+    },
+  });
+}
+
+function templateText(template: Template | undefined): (Node | string)[] {
+  if (!template) return [];
+  return [template.description, template.settings.length ? h("ul", null, template.settings.map((s) =>
+    h("li", null, `${formatHex(s.index)}.${s.subindex} = ${s.value}: ${s.why}`))) : ""];
 }

@@ -3,100 +3,144 @@
  * other (same device), with the differing rows marked.
  */
 
-import type { Page, PageContext } from "../app";
-import { getDictionary, projects, type Project } from "../client/api";
+import type { App, Page, PageContext } from "../app";
+import { getDictionary, projects, type AxisConfig, type Project } from "../client/api";
 import { driveApi } from "../client/drives";
 import { errorText } from "../components/ui";
-import { h, replaceChildren } from "../lib/dom";
+import { debounced, loader, type Loaded } from "../lib/async";
+import { derive, h, Scope, state, type State } from "../lib/dom";
 import { entries, entryKey, type Entry, type Scalar } from "../lib/od";
 import { buildPath } from "../lib/router";
 import { formatValue, sameValue } from "../lib/values";
 
+const MAX_ROWS = 2000;
+const FILTER_DELAY_MS = 150;
+
+export interface Column {
+  title: string;
+  values: Map<string, Scalar>;
+}
+
+/** The values loaded for the chosen axes: one column per axis (and its drive), then the defaults. */
+interface Comparison {
+  list: Entry[];
+  columns: Column[];
+}
+
+interface Options {
+  axes: AxisConfig[];
+  withDrive: boolean;
+  withDefault: boolean;
+}
+
 export async function comparePage(context: PageContext, name: string): Promise<Page> {
   const { app } = context;
   const project: Project = await projects.get(name);
-  const chosen = new Set(project.axes.slice(0, 2).map((axis) => axis.name));
-  const withDrive = h("input", { type: "checkbox", "data-testid": "compare-drive" });
-  const withDefault = h("input", { type: "checkbox", checked: true });
-  const onlyDiff = h("input", { type: "checkbox", checked: true, "data-testid": "compare-only-diff" });
-  const groupFilter = h("input", { type: "search", placeholder: "Filter by name or index", style: { width: "220px" } });
-  const table = h("div", { class: "panel", style: { overflow: "auto" } });
-  const summary = h("span", { class: "muted", "data-testid": "compare-summary" });
-  const boxes = project.axes.map((axis) => {
-    const box = h("input", { type: "checkbox", checked: chosen.has(axis.name), "data-testid": `compare-axis-${axis.name}` });
-    box.addEventListener("change", () => {
-      if (box.checked) chosen.add(axis.name);
-      else chosen.delete(axis.name);
-      void load();
-    });
-    return h("label", { class: "check" }, box, axis.name);
-  });
-  let token = 0;
-
-  const load = async () => {
-    const mine = ++token;
-    const axes = project.axes.filter((axis) => chosen.has(axis.name));
-    if (axes.length === 0) {
-      replaceChildren(table, h("div", { class: "empty-state" }, "Choose at least one axis."));
-      summary.textContent = "";
-      return;
-    }
-    replaceChildren(table, h("div", { class: "empty-state" }, "Loading values…"));
-    try {
-      const devices = new Set(axes.map((axis) => axis.device));
-      if (devices.size > 1) throw new Error(`The chosen axes use different devices (${[...devices].join(", ")}): compare axes of one device.`);
-      const dictionary = await getDictionary(axes[0].device);
-      const list = entries(dictionary);
-      const columns: { title: string; values: Map<string, Scalar> }[] = [];
-      for (const axis of axes) {
-        const rows = (await projects.parameters(project.name, axis.name)).parameters;
-        columns.push({ title: `${axis.name} project`, values: new Map(rows.map((row) => [entryKey(row.index, row.subindex), row.value])) });
-        if (withDrive.checked && app.live.axis(axis.bus, axis.node_id)?.online) {
-          const keys = rows.filter((row) => row.access !== "wo").map((row) => [row.index, row.subindex] as [number, number]);
-          const values = await driveApi.readMany(axis.bus, axis.node_id, keys);
-          columns.push({ title: `${axis.name} drive`, values: new Map(values.filter((v) => !v.error).map((v) => [entryKey(v.index, v.subindex), v.raw])) });
-        }
-      }
-      if (mine !== token) return;
-      if (withDefault.checked) columns.push({ title: "default", values: new Map(list.map((entry) => [entry.key, entry.variable.default])) });
-      const filter = groupFilter.value.trim().toLowerCase();
-      const rows = list.filter((entry) => columns.some((column) => column.values.has(entry.key)))
-        .filter((entry) => !filter || entry.variable.name.toLowerCase().includes(filter) || entry.object.name.toLowerCase().includes(filter)
-          || entry.object.index.toString(16).includes(filter.replace(/^0x/, "")));
-      const differing = (entry: Entry) => {
-        const values = columns.filter((c) => c.values.has(entry.key)).map((c) => c.values.get(entry.key) ?? null);
-        return values.some((value) => !sameValue(value, values[0]));
-      };
-      const shown = onlyDiff.checked ? rows.filter(differing) : rows;
-      summary.textContent = `${shown.length} rows shown · ${rows.filter(differing).length} of ${rows.length} differ`;
-      replaceChildren(table, h("table", { class: "data", "data-testid": "compare-table" },
-        h("thead", null, h("tr", null, h("th", null, "Index"), h("th", null, "Name"), h("th", null, "Unit"), columns.map((c) => h("th", { class: "num" }, c.title)))),
-        h("tbody", null, shown.slice(0, 2000).map((entry) => h("tr", { class: differing(entry) ? "differs" : "" },
-          h("td", { class: "mono" }, `0x${entry.object.index.toString(16).toUpperCase().padStart(4, "0")}.${entry.variable.subindex}`),
-          h("td", { class: "wrap", style: { minWidth: "220px" } }, entry.variable.name === entry.object.name ? entry.variable.name : `${entry.object.name} › ${entry.variable.name}`),
-          h("td", { class: "muted" }, entry.variable.unit),
-          columns.map((c) => h("td", { class: "num mono" }, c.values.has(entry.key) ? formatValue(entry.variable, c.values.get(entry.key)) : "")))))));
-    } catch (error) {
-      if (mine === token) replaceChildren(table, h("div", { class: "message error" }, errorText(error)));
-    }
-  };
-  for (const input of [withDrive, withDefault, onlyDiff]) input.addEventListener("change", () => void load());
-  let timer = 0;
-  groupFilter.addEventListener("input", () => {
-    clearTimeout(timer);
-    timer = window.setTimeout(() => void load(), 150);
-  });
-  await load();
+  const scope = new Scope();
+  const chosen = state<ReadonlySet<string>>(new Set(project.axes.slice(0, 2).map((axis) => axis.name)));
+  const withDrive = state(false);
+  const withDefault = state(true);
+  const onlyDiff = state(true);
+  const filterText = state("");
+  const filter = debounced(scope, filterText, FILTER_DELAY_MS);
+  const loaded = loader(scope, (): Options => ({
+    axes: project.axes.filter((axis) => chosen.val.has(axis.name)), withDrive: withDrive.val, withDefault: withDefault.val,
+  }), (options) => loadComparison(app, project, options));
+  const shown = derive(() => shownRows(loaded.val, filter.val.trim().toLowerCase(), onlyDiff.val));
+  const search = h("input", { type: "search", placeholder: "Filter by name or index", style: { width: "220px" },
+    oninput: (event: Event) => (filterText.val = (event.target as HTMLInputElement).value) });
   return {
     title: `Compare ${project.name}`,
     crumbs: [h("a", { href: "/" }, "Projects"), " / ", h("a", { href: buildPath({ page: "project", project: project.name }) }, project.name), " / Compare"],
-    focusSearch: () => { groupFilter.focus(); return true; },
-    element: h("div", { class: "page" },
-      h("div", { class: "page-head" }, h("h1", null, "Compare"), summary),
-      h("div", { class: "toolbar" }, h("span", { class: "muted" }, "Axes:"), boxes,
-        h("span", { class: "muted" }, "·"), h("label", { class: "check" }, withDrive, "drive values"),
-        h("label", { class: "check" }, withDefault, "defaults"), h("label", { class: "check" }, onlyDiff, "only differences"),
-        groupFilter),
-      table),
+    focusSearch: () => { search.focus(); return true; },
+    dispose: () => scope.dispose(),
+    element: scope.run(() => h("div", { class: "page" },
+      h("div", { class: "page-head" }, h("h1", null, "Compare"),
+        h("span", { class: "muted", "data-testid": "compare-summary" }, () => summary(shown.val))),
+      h("div", { class: "toolbar" }, h("span", { class: "muted" }, "Axes:"), axisChoice(project, chosen),
+        h("span", { class: "muted" }, "·"), checkbox(withDrive, "drive values", "compare-drive"),
+        checkbox(withDefault, "defaults"), checkbox(onlyDiff, "only differences", "compare-only-diff"),
+        search),
+      h("div", { class: "panel", style: { overflow: "auto" } }, () => compareView(loaded.val, shown.val)))),
   };
+}
+
+function checkbox(value: State<boolean>, label: string, testid?: string): HTMLElement {
+  return h("label", { class: "check" }, h("input", {
+    type: "checkbox", checked: value, "data-testid": testid, onchange: (event: Event) => (value.val = (event.target as HTMLInputElement).checked),
+  }), label);
+}
+
+function axisChoice(project: Project, chosen: State<ReadonlySet<string>>): HTMLElement[] {
+  return project.axes.map((axis) => h("label", { class: "check" }, h("input", {
+    type: "checkbox", checked: () => chosen.val.has(axis.name), "data-testid": `compare-axis-${axis.name}`,
+    onchange: (event: Event) => {
+      const next = new Set(chosen.rawVal);
+      if ((event.target as HTMLInputElement).checked) next.add(axis.name);
+      else next.delete(axis.name);
+      chosen.val = next;
+    },
+  }), axis.name));
+}
+
+async function loadComparison(app: App, project: Project, options: Options): Promise<Comparison | null> {
+  const { axes } = options;
+  if (axes.length === 0) return null;
+  const devices = new Set(axes.map((axis) => axis.device));
+  if (devices.size > 1) throw new Error(`The chosen axes use different devices (${[...devices].join(", ")}): compare axes of one device.`);
+  const list = entries(await getDictionary(axes[0].device));
+  const columns: Column[] = [];
+  for (const axis of axes) {
+    const rows = (await projects.parameters(project.name, axis.name)).parameters;
+    columns.push({ title: `${axis.name} project`, values: new Map(rows.map((row) => [entryKey(row.index, row.subindex), row.value])) });
+    if (options.withDrive && app.live.axis(axis.bus, axis.node_id)?.online) {
+      const keys = rows.filter((row) => row.access !== "wo").map((row) => [row.index, row.subindex] as [number, number]);
+      const values = await driveApi.readMany(axis.bus, axis.node_id, keys);
+      columns.push({ title: `${axis.name} drive`, values: new Map(values.filter((v) => !v.error).map((v) => [entryKey(v.index, v.subindex), v.raw])) });
+    }
+  }
+  if (options.withDefault) columns.push({ title: "default", values: new Map(list.map((entry) => [entry.key, entry.variable.default])) });
+  return { list, columns };
+}
+
+/** Whether the columns that have the entry disagree on its value. */
+export function differs(columns: Column[], entry: Entry): boolean {
+  const values = columns.filter((c) => c.values.has(entry.key)).map((c) => c.values.get(entry.key) ?? null);
+  return values.some((value) => !sameValue(value, values[0]));
+}
+
+export interface ShownRows {
+  columns: Column[];
+  rows: Entry[];
+  shown: Entry[];
+  differing: number;
+}
+
+/** The rows any column has, filtered by name or index, and of those the differing ones when asked. */
+export function shownRows(loaded: Loaded<Comparison | null>, filter: string, onlyDifferences: boolean): ShownRows | null {
+  if (loaded.status !== "ready" || !loaded.value) return null;
+  const { list, columns } = loaded.value;
+  const rows = list.filter((entry) => columns.some((column) => column.values.has(entry.key)))
+    .filter((entry) => !filter || entry.variable.name.toLowerCase().includes(filter) || entry.object.name.toLowerCase().includes(filter)
+      || entry.object.index.toString(16).includes(filter.replace(/^0x/, "")));
+  const differing = rows.filter((entry) => differs(columns, entry));
+  return { columns, rows, shown: onlyDifferences ? differing : rows, differing: differing.length };
+}
+
+function summary(shown: ShownRows | null): string {
+  return shown ? `${shown.shown.length} rows shown · ${shown.differing} of ${shown.rows.length} differ` : "";
+}
+
+function compareView(loaded: Loaded<Comparison | null>, shown: ShownRows | null): HTMLElement {
+  if (loaded.status === "loading") return h("div", { class: "empty-state" }, "Loading values…");
+  if (loaded.status === "failed") return h("div", { class: "message error" }, errorText(loaded.error));
+  if (!shown) return h("div", { class: "empty-state" }, "Choose at least one axis.");
+  const { columns } = shown;
+  return h("table", { class: "data", "data-testid": "compare-table" },
+    h("thead", null, h("tr", null, h("th", null, "Index"), h("th", null, "Name"), h("th", null, "Unit"), columns.map((c) => h("th", { class: "num" }, c.title)))),
+    h("tbody", null, shown.shown.slice(0, MAX_ROWS).map((entry) => h("tr", { class: differs(columns, entry) ? "differs" : "" },
+      h("td", { class: "mono" }, `0x${entry.object.index.toString(16).toUpperCase().padStart(4, "0")}.${entry.variable.subindex}`),
+      h("td", { class: "wrap", style: { minWidth: "220px" } }, entry.variable.name === entry.object.name ? entry.variable.name : `${entry.object.name} › ${entry.variable.name}`),
+      h("td", { class: "muted" }, entry.variable.unit),
+      columns.map((c) => h("td", { class: "num mono" }, c.values.has(entry.key) ? formatValue(entry.variable, c.values.get(entry.key)) : ""))))));
 }

@@ -2,21 +2,19 @@
 
 from __future__ import annotations
 
-import os
-import tempfile
-from pathlib import Path
 from typing import Annotated
 
-from fastapi import APIRouter, Depends, File, HTTPException, UploadFile
+from fastapi import APIRouter, Depends, File, UploadFile
 from pydantic import BaseModel, Field
+from starlette.concurrency import run_in_threadpool
 
-from servostudio.api.deps import User, current_user, eds_library
-from servostudio.od import DictionaryError, EdsLibrary, LibraryError, ObjectDictionary, Variable
+from servostudio.api.deps import Library, current_user
+from servostudio.api.errors import error_responses
+from servostudio.errors import ErrorKind
+from servostudio.od import EdsLibrary, ObjectDictionary, Variable
+from servostudio.services import dictionaries
 
-router = APIRouter(prefix="/dictionaries", tags=["dictionaries"])
-
-Library = Annotated[EdsLibrary, Depends(eds_library)]
-Caller = Annotated[User, Depends(current_user)]
+router = APIRouter(prefix="/dictionaries", tags=["dictionaries"], dependencies=[Depends(current_user)])
 
 
 class DictionarySummary(BaseModel):
@@ -79,7 +77,7 @@ def _summary(library: EdsLibrary, od: ObjectDictionary) -> dict:
         "product_code": od.product_code,
         "revision": od.revision,
         "object_count": len(od.objects()),
-        "builtin": library.path_of(od.device).parent == library.builtin_dir,
+        "builtin": dictionaries.is_builtin(library, od.device),
     }
 
 
@@ -107,21 +105,14 @@ def _entry(var: Variable) -> EntryModel:
     )
 
 
-def _load(library: EdsLibrary, device: str) -> ObjectDictionary:
-    try:
-        return library.load(device)
-    except LibraryError as error:
-        raise HTTPException(status_code=404, detail=str(error)) from error
-
-
 @router.get("", response_model=list[DictionarySummary])
-def list_dictionaries(library: Library, _: Caller) -> list[dict]:
+def list_dictionaries(library: Library) -> list[dict]:
     return [_summary(library, library.load(device)) for device in library.devices()]
 
 
-@router.get("/{device}", response_model=DictionaryModel)
-def get_dictionary(device: str, library: Library, _: Caller) -> DictionaryModel:
-    od = _load(library, device)
+@router.get("/{device}", response_model=DictionaryModel, responses=error_responses(ErrorKind.NOT_FOUND))
+def get_dictionary(device: str, library: Library) -> DictionaryModel:
+    od = dictionaries.dictionary(library, device)
     objects = [
         ObjectModel(
             index=obj.index,
@@ -139,22 +130,12 @@ def get_dictionary(device: str, library: Library, _: Caller) -> DictionaryModel:
 @router.post("", response_model=DictionarySummary, status_code=201)
 async def import_dictionary(
     library: Library,
-    _: Caller,
     eds: Annotated[UploadFile, File(description="CiA 306 EDS file")],
     props: Annotated[UploadFile | None, File(description="companion .props file")] = None,
 ) -> dict:
     """Validate an EDS (and its companion properties) and add it to the user library; nothing is kept on error."""
-    with tempfile.TemporaryDirectory() as staging:
-        eds_path = Path(staging) / Path(eds.filename or "upload.eds").name
-        eds_path.write_bytes(await eds.read())
-        props_path = None
-        if props is not None:
-            props_path = eds_path.with_suffix(".props")
-            props_path.write_bytes(await props.read())
-        try:
-            device = library.import_eds(eds_path, props_path)
-        except (DictionaryError, LibraryError) as error:
-            # Name the file as the user uploaded it, not as it was staged on the server.
-            detail = str(error).replace(f"{staging}{os.sep}", "")
-            raise HTTPException(status_code=422, detail=detail) from error
+    props_bytes = await props.read() if props is not None else None
+    device = await run_in_threadpool(
+        dictionaries.import_upload, library, eds.filename or "upload.eds", await eds.read(), props_bytes
+    )
     return _summary(library, library.load(device))

@@ -3,7 +3,7 @@ the routes with live drives are in ``projects_live`` (included at the end), exce
 which take a ``drive`` switch here.
 
 Changes take the ``revision`` the client last read; when someone else changed the project meanwhile the answer is
-409 with ``error: "ConflictError"`` and nothing is written. Errors are ``{"detail": <message>, "error": <kind>}``.
+409 with ``error: "ConflictError"`` and nothing is written. Errors are the API's (``api.errors``).
 """
 
 from __future__ import annotations
@@ -13,14 +13,16 @@ import tempfile
 from pathlib import Path
 from typing import Annotated
 
+import anyio
 from fastapi import APIRouter, Depends, Query, Request, Response
-from fastapi.responses import FileResponse, JSONResponse
+from fastapi.responses import FileResponse
 from starlette.background import BackgroundTask
 from starlette.concurrency import run_in_threadpool
 
-from servostudio.api.deps import get_connections
+from servostudio.api.deps import Live, Projects, current_user
+from servostudio.api.errors import error_responses
 from servostudio.api.routes import projects_live
-from servostudio.api.routes.project_base import Caller, ProjectRoute, Service
+from servostudio.api.routes.drives import DRIVE_ERRORS
 from servostudio.api.routes.project_models import (
     AxisChoiceModel,
     AxisCreate,
@@ -44,8 +46,9 @@ from servostudio.api.routes.project_models import (
     parameter_model,
     project_model,
 )
-from servostudio.services.bus import ConnectionManager
+from servostudio.errors import ErrorKind
 from servostudio.services.projects import ArchiveLimits, Axis, Motor, errors
+from servostudio.services.projects.errors import ArchiveTooLarge
 from servostudio.services.projects.jsonview import (
     choice_view,
     compare_view,
@@ -53,80 +56,84 @@ from servostudio.services.projects.jsonview import (
     summaries,
     template_view,
 )
-from servostudio.services.projects.live import LiveProjects
 from servostudio.services.projects.templates import templates_for
 
-router = APIRouter(tags=["projects"], route_class=ProjectRoute)
-Connections = Annotated[ConnectionManager, Depends(get_connections)]
+#: what the project routes may answer besides their result (the live ones meet the drives' errors too)
+PROJECT_ERRORS = (ErrorKind.NOT_FOUND, ErrorKind.CONFLICT)
+router = APIRouter(tags=["projects"], dependencies=[Depends(current_user)], responses=error_responses(*PROJECT_ERRORS))
 
 
 # ---- projects ---------------------------------------------------------------------------------------------------
 
 
 @router.get("/projects", response_model=list[ProjectSummary])
-def list_projects(service: Service, _: Caller) -> list[ProjectSummary]:
+def list_projects(service: Projects) -> list[ProjectSummary]:
     return [ProjectSummary(**summary) for summary in summaries(service.store)]
 
 
 @router.post("/projects", response_model=ProjectModel, status_code=201)
-def create_project(body: ProjectCreate, service: Service, _: Caller) -> ProjectModel:
+def create_project(body: ProjectCreate, service: Projects) -> ProjectModel:
     return project_model(service.store.create(body.name, body.description, buses_from(body.buses)))
 
 
-@router.post("/projects/unarchive", response_model=ProjectModel, status_code=201)
+@router.post(
+    "/projects/unarchive",
+    response_model=ProjectModel,
+    status_code=201,
+    responses=error_responses(ErrorKind.TOO_LARGE),
+)
 async def unarchive(
-    request: Request, service: Service, _: Caller, new_name: Annotated[str | None, Query()] = None
-) -> Response:
+    request: Request, service: Projects, new_name: Annotated[str | None, Query()] = None
+) -> ProjectModel:
     """Body: the zip archive (``application/zip``). Its size is limited before anything is unpacked."""
     limits = ArchiveLimits()
     with tempfile.TemporaryDirectory() as scratch:
         path = Path(scratch) / "upload.zip"
-        size = 0
-        with open(path, "wb") as stream:
-            async for chunk in request.stream():
-                size += len(chunk)
-                if size > limits.max_total_bytes:
-                    return JSONResponse(
-                        status_code=413,
-                        content={
-                            "detail": f"archive larger than {limits.max_total_bytes} bytes",
-                            "error": "ArchiveError",
-                        },
-                    )
-                stream.write(chunk)
+        await _receive(request, path, limits.max_total_bytes)
         snapshot = await run_in_threadpool(service.unarchive, path, new_name, limits)
-    return JSONResponse(status_code=201, content=project_model(snapshot).model_dump())
+    return project_model(snapshot)
+
+
+async def _receive(request: Request, path: Path, limit: int) -> None:
+    """Spool the request body to ``path``, refusing it as soon as it passes ``limit`` bytes."""
+    size = 0
+    async with await anyio.open_file(path, "wb") as stream:
+        async for chunk in request.stream():
+            size += len(chunk)
+            if size > limit:
+                raise ArchiveTooLarge(f"archive larger than {limit} bytes")
+            await stream.write(chunk)
 
 
 @router.get("/projects/{name}", response_model=ProjectModel)
-def get_project(name: str, service: Service, _: Caller) -> ProjectModel:
+def get_project(name: str, service: Projects) -> ProjectModel:
     return project_model(service.store.open(name))
 
 
 @router.patch("/projects/{name}", response_model=ProjectModel)
-def update_project(name: str, body: ProjectUpdate, service: Service, _: Caller) -> ProjectModel:
+def update_project(name: str, body: ProjectUpdate, service: Projects) -> ProjectModel:
     buses = buses_from(body.buses) if body.buses is not None else None
     return project_model(service.store.update(name, body.revision, description=body.description, buses=buses))
 
 
 @router.delete("/projects/{name}", status_code=204)
-def delete_project(name: str, service: Service, _: Caller, revision: str | None = None) -> Response:
+def delete_project(name: str, service: Projects, revision: str | None = None) -> Response:
     service.store.delete(name, revision)
     return Response(status_code=204)
 
 
 @router.post("/projects/{name}/rename", response_model=ProjectModel)
-def rename_project(name: str, body: NewName, service: Service, _: Caller) -> ProjectModel:
+def rename_project(name: str, body: NewName, service: Projects) -> ProjectModel:
     return project_model(service.store.rename(name, body.new_name, body.revision))
 
 
 @router.post("/projects/{name}/duplicate", response_model=ProjectModel, status_code=201)
-def duplicate_project(name: str, body: NewName, service: Service, _: Caller) -> ProjectModel:
+def duplicate_project(name: str, body: NewName, service: Projects) -> ProjectModel:
     return project_model(service.store.duplicate(name, body.new_name))
 
 
 @router.get("/projects/{name}/archive", response_class=FileResponse)
-def archive_project(name: str, service: Service, _: Caller) -> FileResponse:
+def archive_project(name: str, service: Projects) -> FileResponse:
     scratch = tempfile.mkdtemp()
     path = service.archive(name, Path(scratch) / f"{name}.zip")
     return FileResponse(
@@ -142,19 +149,19 @@ def _remove_tree(path: str) -> None:
 
 
 @router.post("/projects/{name}/axes", response_model=ProjectModel, status_code=201)
-def add_axis(name: str, body: AxisCreate, service: Service, _: Caller) -> ProjectModel:
+def add_axis(name: str, body: AxisCreate, service: Projects) -> ProjectModel:
     axis = Axis(body.name, body.device, body.node_id, body.bus, body.description)
     return project_model(service.store.add_axis(name, axis, body.revision))
 
 
 @router.patch("/projects/{name}/axes/{axis}", response_model=ProjectModel)
-def edit_axis(name: str, axis: str, body: AxisUpdate, service: Service, _: Caller) -> ProjectModel:
+def edit_axis(name: str, axis: str, body: AxisUpdate, service: Projects) -> ProjectModel:
     changes = body.model_dump(exclude_none=True, exclude={"revision"})
     return project_model(service.store.edit_axis(name, axis, body.revision, **changes))
 
 
 @router.delete("/projects/{name}/axes/{axis}", response_model=ProjectModel)
-def remove_axis(name: str, axis: str, service: Service, _: Caller, revision: str | None = None) -> ProjectModel:
+def remove_axis(name: str, axis: str, service: Projects, revision: str | None = None) -> ProjectModel:
     return project_model(service.store.remove_axis(name, axis, revision))
 
 
@@ -162,8 +169,7 @@ def remove_axis(name: str, axis: str, service: Service, _: Caller, revision: str
 def list_parameters(
     name: str,
     axis: str,
-    service: Service,
-    _: Caller,
+    service: Projects,
     group: str | None = None,
     only_set: bool = False,
     only_differences: bool = False,
@@ -176,78 +182,77 @@ def list_parameters(
 
 
 @router.get("/projects/{name}/axes/{axis}/parameters/{address}", response_model=ParameterModel)
-def get_parameter(name: str, axis: str, address: str, service: Service, _: Caller) -> ParameterModel:
+def get_parameter(name: str, axis: str, address: str, service: Projects) -> ParameterModel:
     row, _revision = service.parameters.get(name, axis, address)
     return parameter_model(row)
 
 
 @router.put("/projects/{name}/axes/{axis}/parameters", response_model=ParameterList)
-def set_parameters(name: str, axis: str, body: ParameterWrite, service: Service, _: Caller) -> ParameterList:
+def set_parameters(name: str, axis: str, body: ParameterWrite, service: Projects) -> ParameterList:
     change = service.parameters.set(name, axis, body.values, body.revision)
     return ParameterList(parameters=[parameter_model(row) for row in change.rows], revision=change.revision)
 
 
 @router.post("/projects/{name}/axes/{axis}/parameters/reset", response_model=ParameterList)
-def reset_parameters(name: str, axis: str, body: ParameterReset, service: Service, _: Caller) -> ParameterList:
+def reset_parameters(name: str, axis: str, body: ParameterReset, service: Projects) -> ParameterList:
     change = service.parameters.unset(name, axis, body.addresses, body.revision)
     return ParameterList(parameters=[parameter_model(row) for row in change.rows], revision=change.revision)
 
 
-@router.get("/projects/{name}/axes/{axis}/compare", response_model=CompareModel)
+@router.get(
+    "/projects/{name}/axes/{axis}/compare", response_model=CompareModel, responses=error_responses(*DRIVE_ERRORS)
+)
 def compare_axis(
     name: str,
     axis: str,
-    service: Service,
-    connections: Connections,
-    _: Caller,
+    service: Projects,
+    live: Live,
     group: str | None = None,
     only_differences: bool = False,
     drive: bool = False,
 ) -> CompareModel:
     """Project / default columns; with ``drive=true`` drive / project / default, read from the axis's live drive
     (its bus is opened on the server if needed), and a row differs when the drive's value is not the project's."""
-    if not drive:
-        rows, revision = service.parameters.compare(name, axis, group=group, only_differences=only_differences)
+    if drive:
+        found = live.compare(name, axis, group=group, only_differences=only_differences)
         return CompareModel(
-            columns=["project", "default"],
-            revision=revision,
-            rows=[CompareRowModel(**compare_view(row)) for row in rows],
+            columns=["drive", "project", "default"],
+            revision=found.revision,
+            refused=found.refused,
+            rows=[CompareRowModel(**compare_view(row)) for row in found.rows],
         )
-    live = LiveProjects(service, connections).compare(name, axis, group=group, only_differences=only_differences)
+    rows, revision = service.parameters.compare(name, axis, group=group, only_differences=only_differences)
     return CompareModel(
-        columns=["drive", "project", "default"],
-        revision=live.revision,
-        refused=live.refused,
-        rows=[CompareRowModel(**compare_view(row)) for row in live.rows],
+        columns=["project", "default"], revision=revision, rows=[CompareRowModel(**compare_view(row)) for row in rows]
     )
 
 
-@router.post("/projects/{name}/axes/{axis}/motor", response_model=AxisChoiceModel)
-def select_motor(
-    name: str, axis: str, body: MotorChoice, service: Service, connections: Connections, _: Caller
-) -> AxisChoiceModel:
+@router.post(
+    "/projects/{name}/axes/{axis}/motor", response_model=AxisChoiceModel, responses=error_responses(*DRIVE_ERRORS)
+)
+def select_motor(name: str, axis: str, body: MotorChoice, service: Projects, live: Live) -> AxisChoiceModel:
     """Offline: the project reproduces the drive's side effects. With ``drive: true`` the motor is written to the
     axis's live drive and the values the drive derived are read back into the project."""
     if body.drive:
-        choice = LiveProjects(service, connections).select_motor(name, axis, body.reference, body.revision)
+        choice = live.select_motor(name, axis, body.reference, body.revision)
     else:
         choice = service.select_motor(name, axis, body.reference, body.revision)
     return AxisChoiceModel(**choice_view(choice))
 
 
 @router.get("/projects/{name}/axes/{axis}/application", response_model=TemplateModel | None)
-def get_application(name: str, axis: str, service: Service, _: Caller) -> TemplateModel | None:
+def get_application(name: str, axis: str, service: Projects) -> TemplateModel | None:
     chosen = service.application(name, axis)
     return TemplateModel(**template_view(chosen)) if chosen is not None else None
 
 
 @router.post("/projects/{name}/axes/{axis}/application", response_model=AxisChoiceModel)
-def apply_application(name: str, axis: str, body: TemplateChoice, service: Service, _: Caller) -> AxisChoiceModel:
+def apply_application(name: str, axis: str, body: TemplateChoice, service: Projects) -> AxisChoiceModel:
     return AxisChoiceModel(**choice_view(service.apply_template(name, axis, body.template, body.revision)))
 
 
 @router.get("/projects/{name}/axes/{axis}/dcf")
-def export_dcf(name: str, axis: str, service: Service, _: Caller) -> Response:
+def export_dcf(name: str, axis: str, service: Projects) -> Response:
     text = service.dcf(name, axis)
     return Response(
         text.encode("latin-1"),
@@ -260,12 +265,12 @@ def export_dcf(name: str, axis: str, service: Service, _: Caller) -> Response:
 
 
 @router.get("/motors", response_model=list[MotorModel])
-def list_motors(service: Service, _: Caller) -> list[MotorModel]:
+def list_motors(service: Projects) -> list[MotorModel]:
     return [MotorModel(**motor_view(motor)) for motor in service.motors.motors()]
 
 
 @router.post("/motors", response_model=MotorModel, status_code=201)
-def add_motor(body: MotorModel, service: Service, _: Caller) -> MotorModel:
+def add_motor(body: MotorModel, service: Projects) -> MotorModel:
     """ "Add new motor": a user catalog entry (built-in references cannot be reused)."""
     objects = {}
     for key, value in body.objects.items():
@@ -279,14 +284,14 @@ def add_motor(body: MotorModel, service: Service, _: Caller) -> MotorModel:
 
 
 @router.delete("/motors/{reference}", status_code=204)
-def remove_motor(reference: str, service: Service, _: Caller) -> Response:
+def remove_motor(reference: str, service: Projects) -> Response:
     """Remove a user motor (built-in motors stay)."""
     service.motors.remove(reference)
     return Response(status_code=204)
 
 
 @router.get("/device-templates", response_model=list[TemplateModel])
-def list_templates(_: Caller, device: str = "xtrapulspac") -> list[TemplateModel]:
+def list_templates(device: str = "xtrapulspac") -> list[TemplateModel]:
     return [TemplateModel(**template_view(template)) for template in templates_for(device)]
 
 

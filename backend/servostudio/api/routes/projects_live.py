@@ -8,21 +8,18 @@ opened on first use and shared with every other client.
 
 from __future__ import annotations
 
-from typing import Annotated, Literal
+from typing import Literal
 
 from fastapi import APIRouter, Depends, status
 from pydantic import BaseModel, Field
 
-from servostudio.api.deps import get_connections, get_jobs
+from servostudio.api.deps import Jobs, Live, current_user
+from servostudio.api.errors import error_responses
 from servostudio.api.routes.comm_models import JobModel, NodeIdentity
-from servostudio.api.routes.project_base import Caller, ProjectRoute, Service
+from servostudio.api.routes.drives import DRIVE_ERRORS
 from servostudio.api.routes.project_models import ParameterList, ProjectModel, parameter_model, project_model
-from servostudio.services.bus import ConnectionManager, JobRegistry
-from servostudio.services.projects.live import LiveProjects
 
-router = APIRouter(tags=["projects"], route_class=ProjectRoute)
-Connections = Annotated[ConnectionManager, Depends(get_connections)]
-Jobs = Annotated[JobRegistry, Depends(get_jobs)]
+router = APIRouter(tags=["projects"], dependencies=[Depends(current_user)], responses=error_responses(*DRIVE_ERRORS))
 
 
 class TakeRequest(BaseModel):
@@ -94,50 +91,34 @@ class ScanResultModel(BaseModel):
 
 
 @router.post("/projects/{name}/axes/{axis}/take-from-drive", response_model=ParameterList)
-def take_from_drive(
-    name: str, axis: str, body: TakeRequest, service: Service, connections: Connections, _: Caller
-) -> ParameterList:
+def take_from_drive(name: str, axis: str, body: TakeRequest, live: Live) -> ParameterList:
     """Store the drive's values in the project (checked like offline edits; all or nothing)."""
-    change = LiveProjects(service, connections).take(name, axis, body.addresses, body.revision)
+    change = live.take(name, axis, body.addresses, body.revision)
     return ParameterList(parameters=[parameter_model(row) for row in change.rows], revision=change.revision)
 
 
 @router.post("/projects/{name}/axes/{axis}/write-to-drive", response_model=DriveWriteReportModel)
-def write_to_drive(
-    name: str, axis: str, body: WriteRequest, service: Service, connections: Connections, _: Caller
-) -> DriveWriteReportModel:
+def write_to_drive(name: str, axis: str, body: WriteRequest, live: Live) -> DriveWriteReportModel:
     """Write the project's values to the drive; every value is checked like an online write before the first is
     sent, so one bad value writes nothing (422)."""
-    report = LiveProjects(service, connections).write(name, axis, body.addresses, body.store)
-    return DriveWriteReportModel(**report.as_dict())
+    report = live.write(name, axis, body.addresses, body.store)
+    return DriveWriteReportModel.model_validate(report.as_dict())
 
 
 @router.post("/projects/{name}/commission", response_model=JobModel, status_code=status.HTTP_202_ACCEPTED)
-def start_commission(
-    name: str, body: CommissionRequest, service: Service, connections: Connections, jobs: Jobs, _: Caller
-) -> dict:
+def start_commission(name: str, body: CommissionRequest, live: Live, jobs: Jobs) -> dict:
     """Runs as a job: follow ``progress`` and ``job`` events on ``/api/ws/events`` or poll ``GET /api/jobs/{id}``;
     the result is the report per axis (status ok / bus_down / no_answer / wrong_device, files restored or read)."""
-    service.store.open(name)  # an unknown project is refused now (404), not in the job
-    live = LiveProjects(service, connections)
-
-    def work(progress, cancel) -> dict:
-        return live.commission(
-            name, body.direction, body.axes, body.revision, progress=progress, cancel=cancel
-        ).as_dict()
-
-    return jobs.start(f"commission-{body.direction}", work).as_dict()
+    return live.start_commission(jobs, name, body.direction, body.axes, body.revision).as_dict()
 
 
 @router.post("/projects/{name}/scan", response_model=ScanResultModel)
-def scan_into_project(
-    name: str, body: ScanRequest, service: Service, connections: Connections, _: Caller
-) -> ScanResultModel:
+def scan_into_project(name: str, body: ScanRequest, live: Live) -> ScanResultModel:
     """Scan a bus and add an axis for every identified node not yet in the project (one project change)."""
-    report = LiveProjects(service, connections).scan(name, body.bus, body.bus_name, body.revision, body.create)
+    report = live.scan(name, body.bus, body.bus_name, body.revision, body.create)
     return ScanResultModel(
         bus=report.bus.name,
         bus_added=report.bus_added,
-        nodes=[ScannedNodeModel(**node.as_dict()) for node in report.nodes],
+        nodes=[ScannedNodeModel.model_validate(node.as_dict()) for node in report.nodes],
         project=project_model(report.snapshot),
     )

@@ -1,11 +1,9 @@
 """The caller's identity as the server sees it (the top bar shows it; user levels build on it)."""
 
-from typing import Annotated
-
-from fastapi import APIRouter, Depends
+from fastapi import APIRouter
 from pydantic import BaseModel, Field
 
-from servostudio.api.deps import User, current_user
+from servostudio.api.deps import Caller
 
 router = APIRouter(tags=["users"])
 
@@ -16,5 +14,5 @@ class UserModel(BaseModel):
 
 
 @router.get("/me", response_model=UserModel)
-def get_me(user: Annotated[User, Depends(current_user)]) -> UserModel:
+def get_me(user: Caller) -> UserModel:
     return UserModel(name=user.name, level=user.level)

@@ -7,6 +7,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 
 from servostudio.drive.faults import FaultInfo
+from servostudio.errors import NotFound
 from servostudio.od.model import SaveType
 
 #: Objects every CiA 301 device has, and those of a CiA 402 drive, by semantic name.
@@ -35,7 +36,7 @@ CIA402_OBJECTS: dict[str, tuple[int, int]] = {
 }
 
 
-class EmcyLayout(str, enum.Enum):
+class EmcyLayout(enum.StrEnum):
     """How a device fills the manufacturer bytes 3..7 of its EMCY frames."""
 
     CODE_BYTE = "code_byte"  # byte 3 = the manufacturer error code (bit number + 1)
@@ -53,7 +54,7 @@ class Addressing:
     redirect_offset: int | None = None
 
 
-class ProfileError(KeyError):
+class ProfileError(NotFound, KeyError):
     """The device has no object or signature of that semantic name."""
 
     def __str__(self) -> str:

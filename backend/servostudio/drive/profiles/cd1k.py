@@ -1,6 +1,7 @@
 """Infranor CD1-k: drive error word 0x3020 (also in the EMCY manufacturer bytes); 'save' only with the drive disabled.
 
-Source: /work/shared/spec/cd1k-canopen.md §2.6 (seed L546–579).  Bits 16–18 carry a coded power fault.
+Source: the CD1-k CANopen communication profile, L546–579 (manual 001 in docs/devices.md).  Bits 16–18 carry a
+coded power fault.
 """
 
 from __future__ import annotations

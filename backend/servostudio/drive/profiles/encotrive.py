@@ -1,6 +1,6 @@
 """TR-Electronic encoTRive MD-025: standard CiA 301/402 objects; faults only as EMCY / 0x603F codes.
 
-Source: /work/shared/spec/encotrive-canopen.md §2.6 (the manufacturer EMCY bytes are unused).
+Source: the encoTRive MD-025 manual, L429 (manual 004 in docs/devices.md): the manufacturer EMCY bytes are unused.
 """
 
 from __future__ import annotations

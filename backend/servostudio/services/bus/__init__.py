@@ -2,7 +2,7 @@
 
 from servostudio.services.bus.connections import BusConnection, ConnectionManager, NodeInfo, UnknownBusOrNode
 from servostudio.services.bus.events import EventHub, Subscription
-from servostudio.services.bus.jobs import Job, JobRegistry
+from servostudio.services.bus.jobs import Job, JobRegistry, UnitResults
 
 __all__ = [
     "BusConnection",
@@ -12,5 +12,6 @@ __all__ = [
     "JobRegistry",
     "NodeInfo",
     "Subscription",
+    "UnitResults",
     "UnknownBusOrNode",
 ]

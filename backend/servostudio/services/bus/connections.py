@@ -11,14 +11,17 @@ import itertools
 import threading
 from collections.abc import Callable
 from dataclasses import asdict, dataclass, field
+from typing import Protocol
 
 import can
 
 from servostudio.drive.access import Drive
 from servostudio.drive.link import BusLink
 from servostudio.drive.monitor import BusMonitor
+from servostudio.drive.nmt import NmtCommand, send_nmt
 from servostudio.drive.profiles import DeviceProfile, profile_for
 from servostudio.drive.sdo import SdoEngine
+from servostudio.errors import Conflict, NotFound
 from servostudio.od.library import EdsLibrary, builtin_library
 from servostudio.services.bus.events import EventHub
 from servostudio.services.bus.statewatch import StatuswordWatch
@@ -29,8 +32,16 @@ SERIAL_SDO_TIMEOUT = 1.0  # at 19200 baud a request and its answer alone take 12
 CAN_SDO_TIMEOUT = 0.5
 
 
-class UnknownBusOrNode(LookupError):
+class UnknownBusOrNode(NotFound):
     """Unknown bus or node."""
+
+
+class BusNameTaken(Conflict):
+    """Another bus is already open under the name asked for."""
+
+
+class Simulation(Protocol):
+    def stop(self) -> None: ...
 
 
 @dataclass
@@ -63,7 +74,7 @@ class BusConnection:
     library: EdsLibrary
     events: EventHub
     nodes: dict[int, NodeInfo] = field(default_factory=dict)
-    simulation: object | None = None
+    simulation: Simulation | None = None  # the simulated drives of a ``sim`` bus, stopped with it
     monitor: BusMonitor | None = None
     _identifying: dict[int, threading.Lock] = field(default_factory=dict, repr=False)
     _identifying_guard: threading.Lock = field(default_factory=threading.Lock, repr=False)
@@ -96,6 +107,21 @@ class BusConnection:
 
                 info = identify(self, node)
         return info.device if info else None
+
+    def nmt(self, command: str, node: int = 0) -> NmtCommand:
+        """Send an NMT command named as the CLI and REST name it (``start``, ``reset-node``, …); node 0: all."""
+        parsed = NmtCommand.parse(command)
+        send_nmt(self.link, parsed, node)
+        return parsed
+
+    def report_statusword(self, node: int, statusword: int) -> None:
+        """Publish a drive_state event when a status word read elsewhere shows a state change."""
+        if self.monitor is not None:
+            self.monitor.report_statusword(node, statusword)
+
+    def nmt_state(self, node: int) -> str | None:
+        """The node's NMT state as its last heartbeat or boot-up said (None before any)."""
+        return self.monitor.nmt_state(node) if self.monitor is not None else None
 
     def profile_of(self, node: int) -> DeviceProfile | None:
         info = self.nodes.get(node)
@@ -135,7 +161,7 @@ class ConnectionManager:
                     return existing
             bus_id = bus_id or self._free_id(spec.kind)
             if bus_id in self._buses:
-                raise ValueError(f"a bus named {bus_id!r} is already open")
+                raise BusNameTaken(f"a bus named {bus_id!r} is already open")
         opener, simulation = self._opener(spec)
         link = BusLink(bus_id, opener)
         timeout = SERIAL_SDO_TIMEOUT if spec.kind == "serial" else CAN_SDO_TIMEOUT
@@ -159,7 +185,7 @@ class ConnectionManager:
         candidates = itertools.chain([kind], (f"{kind}{number}" for number in itertools.count(2)))
         return next(name for name in candidates if name not in self._buses)
 
-    def _opener(self, spec: BusSpec) -> tuple[Callable[[], can.BusABC], object | None]:
+    def _opener(self, spec: BusSpec) -> tuple[Callable[[], can.BusABC], Simulation | None]:
         if spec.kind != "sim":
             return (lambda: open_bus(spec)), None
         from servostudio.sim.network import SimulatedNetwork

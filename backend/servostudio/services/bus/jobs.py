@@ -4,28 +4,63 @@ A REST call that would take seconds starts a job and returns its id at once; the
 ``/api/ws/events`` (``progress`` and ``job`` events) or polls ``GET /api/jobs/{id}``.  A client may cancel a
 running job: the work gets a ``Cancellation``, stops at the next object or file boundary and returns what it did
 so far; the job then ends ``cancelled`` with that result.
+
+A job's states: ``running``, then ``done``, ``partial`` (some of its units — the nodes of a backup — failed, the
+others completed), ``failed`` (the work raised, or every unit failed) or ``cancelled``.  Work made of units returns
+`UnitResults`, so "every node failed" is not reported as done.
 """
 
 from __future__ import annotations
 
 import itertools
+import logging
 import threading
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
+from servostudio.errors import NotFound, ServoStudioError
 from servostudio.services.bus.events import EventHub
 from servostudio.services.cancel import Cancellation
 
+log = logging.getLogger(__name__)
 Progress = Callable[[dict[str, object]], None]
 KEEP_JOBS = 100
+
+
+class UnknownJob(NotFound):
+    """No job of that id (never started, or one of the oldest, forgotten)."""
+
+
+@dataclass(frozen=True)
+class UnitResults:
+    """What work made of independent units returns: ``result`` (JSON-ready, one entry per unit) and, for each unit
+    that failed, why (``failures``, e.g. ``"node 2: no SDO response…"``); ``units`` counts them all."""
+
+    result: object
+    units: int
+    failures: tuple[str, ...] = ()
+
+    @property
+    def state(self) -> str:
+        if not self.failures:
+            return "done"
+        return "failed" if len(self.failures) >= self.units else "partial"
+
+    @property
+    def error(self) -> str:
+        """One line for the job's ``error``: how many units failed and the first reasons."""
+        if not self.failures:
+            return ""
+        shown = "; ".join(self.failures[:3]) + ("; …" if len(self.failures) > 3 else "")
+        return f"{len(self.failures)} of {self.units} failed: {shown}"
 
 
 @dataclass
 class Job:
     id: str
     operation: str
-    state: str = "running"  # running | done | failed | cancelled
+    state: str = "running"  # running | done | partial | failed | cancelled
     result: object = None
     error: str = ""
     started: float = field(default_factory=time.time)
@@ -60,31 +95,51 @@ class JobRegistry:
             for old in list(self._jobs)[:-KEEP_JOBS]:
                 del self._jobs[old]
 
+        threading.Thread(target=self._run, args=(job, work), name=job.id, daemon=True).start()
+        return job
+
+    def _run(self, job: Job, work: Callable[[Progress, Cancellation], object]) -> None:
         def progress(event: dict[str, object]) -> None:
             self.events.publish({**event, "job": job.id})
 
-        def run() -> None:
-            try:
-                job.result = work(progress, job.cancellation)
-                job.state = "cancelled" if job.cancellation.requested else "done"
-            except Exception as error:  # the job reports any failure to its client
-                job.error = str(error)
-                job.state = "cancelled" if job.cancellation.requested else "failed"
-            job.finished = time.time()
-            self.events.publish({"type": "job", **job.as_dict()})
+        try:
+            _record(job, work(progress, job.cancellation))
+        except Exception as error:  # noqa: BLE001 - the job reports any failure to its client; a bug is logged too
+            job.state, job.error = "failed", _reason(job, error)
+        if job.cancellation.requested:
+            job.state = "cancelled"
+        job.finished = time.time()
+        self.events.publish({"type": "job", **job.as_dict()})
 
-        threading.Thread(target=run, name=job.id, daemon=True).start()
-        return job
-
-    def cancel(self, job_id: str) -> Job | None:
-        """Ask a running job to stop (no effect on a finished one); None for an unknown id."""
-        job = self._jobs.get(job_id)
-        if job is not None and job.state == "running":
+    def cancel(self, job_id: str) -> Job:
+        """Ask a running job to stop (no effect on a finished one)."""
+        job = self.get(job_id)
+        if job.state == "running":
             job.cancellation.cancel()
         return job
 
-    def get(self, job_id: str) -> Job | None:
-        return self._jobs.get(job_id)
+    def get(self, job_id: str) -> Job:
+        try:
+            return self._jobs[job_id]
+        except KeyError:
+            raise UnknownJob(f"no job {job_id!r}") from None
 
     def list(self) -> list[Job]:
         return list(self._jobs.values())
+
+
+def _record(job: Job, outcome: object) -> None:
+    """The job's result and state from what its work returned."""
+    if isinstance(outcome, UnitResults):
+        job.result, job.state, job.error = outcome.result, outcome.state, outcome.error
+    else:
+        job.result, job.state = outcome, "done"
+
+
+def _reason(job: Job, error: Exception) -> str:
+    """The error a client sees; one outside the taxonomy is a bug, logged here, and its text (which may name
+    server paths) stays in the log."""
+    if isinstance(error, ServoStudioError):
+        return str(error)
+    log.exception("%s %s failed unexpectedly", job.operation, job.id)
+    return f"internal error in {job.operation} {job.id}; the server log has the details"

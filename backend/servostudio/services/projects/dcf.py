@@ -70,7 +70,7 @@ def format_value(variable: Variable, value: Value) -> str:
     """EDS spelling: integers hex for unsigned types and decimal for signed ones, REAL as its bit pattern."""
     data_type = variable.data_type
     if data_type.is_float:
-        return float_bit_pattern(data_type, float(value))  # type: ignore[arg-type]
+        return float_bit_pattern(data_type, float(value))
     if isinstance(value, bytes):
         return value.hex().upper()
     if isinstance(value, int) and not data_type.is_signed:

@@ -11,7 +11,7 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 
 from servostudio.services.projects import tomlsubset
-from servostudio.services.projects.errors import FileFormatError
+from servostudio.services.projects.errors import FileFormatError, ValidationError
 
 FORMAT_VERSION = 1
 HEADER_COMMENT = "Servo Studio project file (format 1): see docs/projects.md"
@@ -51,6 +51,13 @@ class Project:
 
     def bus(self, name: str) -> Bus | None:
         return next((bus for bus in self.buses if bus.name == name), None)
+
+    def bus_of(self, axis: Axis) -> Bus:
+        """The bus an axis is on (the store's rules make sure the project has it)."""
+        bus = self.bus(axis.bus)
+        if bus is None:
+            raise ValidationError(f"axis '{axis.name}' is on bus '{axis.bus}', which project '{self.name}' lacks")
+        return bus
 
     def with_axes(self, axes: tuple[Axis, ...]) -> Project:
         return replace(self, axes=axes)
@@ -117,9 +124,9 @@ def from_text(text: str, source: Path | str, name: str) -> Project:
     return Project(name, reader.get(head, "description", str, ""), tuple(buses), tuple(axes))
 
 
-def _table(values: dict[str, object]) -> tomlsubset.Table:
+def _table(values: dict[str, tomlsubset.Value | None]) -> tomlsubset.Table:
     """Empty optional values are left out, so adding e.g. a motor later is a one-line change."""
-    return tomlsubset.Table(values={key: value for key, value in values.items() if value not in (None, "")})
+    return tomlsubset.Table(values={key: value for key, value in values.items() if value is not None and value != ""})
 
 
 _REQUIRED = object()

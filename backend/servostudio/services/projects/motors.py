@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import os
 import re
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -29,7 +30,14 @@ from servostudio.services.projects.errors import FileFormatError, ProjectExists,
 from servostudio.services.projects.fsutil import atomic_write
 from servostudio.services.projects.names import check_name, same_name
 
-BUILTIN_MOTORS_DIR = Path(os.environ.get("SERVOSTUDIO_MOTORS_DIR") or Path(__file__).resolve().parents[4] / "motors")
+#: the repository's ``motors/`` folder; ``builtin_motors_dir()`` is what a process uses
+BUILTIN_MOTORS_DIR = Path(__file__).resolve().parents[4] / "motors"
+
+
+def builtin_motors_dir(environ: Mapping[str, str] = os.environ) -> Path:
+    """The built-in catalog: ``SERVOSTUDIO_MOTORS_DIR``, else the repository's ``motors/`` (read when asked)."""
+    return Path(environ.get("SERVOSTUDIO_MOTORS_DIR") or BUILTIN_MOTORS_DIR)
+
 
 #: The motor data of a catalog entry, in the order of the sub-entries 1..25 of the XtrapulsPac's 0x6410 Motor Data
 #: (manual L4894-5268), which is what Gem Drive Studio's catalog fills in.
@@ -132,11 +140,12 @@ def motor_from_text(text: str, source: Path | str, builtin: bool = False) -> Mot
                 f'[objects] key {key!r} must look like "0x3324,1" and its value be a number or a string',
             )
         objects[(int(match[1], 16), int(match[2]))] = value
-    motor_data = {name: data.values[name] for name in MOTOR_DATA_FIELDS if name in data.values}
+    checked = {name: value for name, value in data.values.items() if isinstance(value, int | str)}  # all, checked
+    motor_data = {name: checked[name] for name in MOTOR_DATA_FIELDS if name in checked}
     return Motor(
-        head.values["reference"],
-        head.values.get("description", ""),
-        head.values.get("source", ""),
+        str(head.values["reference"]),
+        str(head.values.get("description", "")),
+        str(head.values.get("source", "")),
         motor_data,
         objects,
         builtin,

@@ -95,8 +95,8 @@ def apply_motor(values: AxisValues, motor: Motor) -> MotorApplication:
         changed.append(_stage(values, layout.subs[name], value, motor))
         if name in layout.copies:
             _consequence(values, layout.copies[name], value, changed, notes)
-    for key, value in sorted(motor.objects.items()):
-        changed.append(_stage(values, key, value, motor))
+    for key, setting in sorted(motor.objects.items()):
+        changed.append(_stage(values, key, setting, motor))
     _current_limits(values, layout, motor, changed, notes)
     return MotorApplication(changed, notes)
 
@@ -114,7 +114,10 @@ def _stage(values: AxisValues, key: Key, value: object, motor: Motor) -> Variabl
 
 def _consequence(values: AxisValues, key: Key, value: object, changed: list[Variable], notes: list[str]) -> None:
     target = values.dictionary.get(*key)
-    reason = f"0x{key[0]:04X},{key[1]} is not in the dictionary" if target is None else values.editable_reason(target)
+    if target is None:
+        notes.append(f"not set: 0x{key[0]:04X},{key[1]} is not in the dictionary")
+        return
+    reason = values.editable_reason(target)
     if reason:
         notes.append(f"not set: {reason}")
         return
@@ -143,7 +146,9 @@ def _current_limits(
             "current limits derived from the motor data alone: the drive's current ratings 0x6510,1/2 are "
             "unknown offline and the drive caps the limits to them"
         )
-    rated, maximum = current_limits(stall or 0, peak or 0, *drive)
+    rated, maximum = current_limits(
+        stall if isinstance(stall, int) else 0, peak if isinstance(peak, int) else 0, *drive
+    )
     if rated:
         _consequence(values, layout.rated_current, rated, changed, notes)
         _consequence(values, layout.max_current, maximum, changed, notes)

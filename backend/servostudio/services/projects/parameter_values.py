@@ -9,13 +9,14 @@ from __future__ import annotations
 
 import struct
 
+from servostudio.errors import InvalidInput
 from servostudio.formats.numbers import parse_integer
 from servostudio.od import DataType, Variable
 
 Value = int | float | str | bytes
 
 
-class BadValue(ValueError):
+class BadValue(InvalidInput):
     """A value cannot be interpreted for an object; the message names the object."""
 
 

@@ -21,7 +21,7 @@ import tempfile
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass, replace
 from pathlib import Path
-from typing import Protocol
+from typing import Any, Protocol
 
 from servostudio.services.projects import layout
 from servostudio.services.projects.devices import axis_files
@@ -188,9 +188,7 @@ class ProjectStore:
             edit.save(project)
         return Snapshot(edit.project, edit.revision)
 
-    def edit_axis(
-        self, project: str, axis_name: str, expected_revision: str | None = None, **changes: object
-    ) -> Snapshot:
+    def edit_axis(self, project: str, axis_name: str, expected_revision: str | None = None, **changes: Any) -> Snapshot:
         """Change fields of an axis (``name``, ``device``, ``node_id``, ``bus``, ``description``); renaming an axis
         renames its directory."""
         unknown = set(changes) - {"name", "device", "node_id", "bus", "description"}
@@ -199,8 +197,8 @@ class ProjectStore:
         with self.edit(project, expected_revision) as edit:
             old = edit.axis(axis_name)
             new = replace(old, **changes)
-            project = edit.project.with_axes(tuple(new if axis is old else axis for axis in edit.project.axes))
-            self._validate(project)
+            changed = edit.project.with_axes(tuple(new if axis is old else axis for axis in edit.project.axes))
+            self._validate(changed)
             moving = new.name != old.name and (edit.directory / old.name).is_dir()
             if moving and (edit.directory / new.name).exists() and not same_name(old.name, new.name):
                 raise ProjectExists(f"'{edit.directory / new.name}' already exists; choose another axis name")
@@ -208,7 +206,7 @@ class ProjectStore:
                 _switch_device_files(edit.directory / old.name, old, new.device)
             if moving:
                 os.rename(edit.directory / old.name, edit.directory / new.name)
-            edit.save(project)
+            edit.save(changed)
         return Snapshot(edit.project, edit.revision)
 
     def replace_axis(self, edit: ProjectEdit, axis: Axis) -> None:

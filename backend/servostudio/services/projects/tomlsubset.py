@@ -22,6 +22,7 @@ import math
 import re
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import NoReturn
 
 from servostudio.services.projects.errors import FileFormatError
 
@@ -142,7 +143,7 @@ class _Cursor:
         self.source = source
         self.number = number
 
-    def fail(self, reason: str) -> None:
+    def fail(self, reason: str) -> NoReturn:
         raise FileFormatError(self.source, self.number, reason)
 
     def peek(self) -> str:

@@ -1,10 +1,11 @@
 """The simulated drive: CiA 402 device control, operation modes, loops, physics, protections and procedures,
-bound to one node's `ObjectStore` (contract: /work/notes/sim-contract.md, docs/control-loops.md).
+bound to one node's `ObjectStore` (docs/simulator.md, docs/control-loops.md).
 
 Each control period (`step`) the drive reads its control word, runs the state machine and the active mode's
-set-point generator, checks its protections, runs the loops and the physics, and publishes its measurements.
-Parameters (gains, limits, option codes) are re-read every 32 ms and right after any bus write to them;
-protections, inputs and the status word run every 1 ms; measurements are computed when the bus reads them.
+set-point generator, checks its protections, runs the loops and the physics, and publishes its measurements;
+last, an armed oscilloscope recorder (docs/scope.md) samples the period's values. Parameters (gains, limits,
+option codes) are re-read every 32 ms and right after any bus write to them; protections, inputs and the status
+word run every 1 ms; measurements are computed when the bus reads them.
 """
 
 from __future__ import annotations
@@ -40,6 +41,7 @@ from servostudio.sim.drive.modes import (
 from servostudio.sim.drive.physics import OVERCURRENT_FACTOR, TWO_PI, AxisPhysics
 from servostudio.sim.drive.procedures import ABORTED, FAILED
 from servostudio.sim.drive.protection import I2tProtection
+from servostudio.sim.drive.recorder import Recorder
 from servostudio.sim.drive.runner import ProcedureRunner
 from servostudio.sim.drive.statemachine import (
     STATE_BITS,
@@ -127,7 +129,7 @@ class DriveBehaviour:
         self.max_current = 1.0
         self.drive_max_current = 1.0
         self._addresses = {name: addr for name, addr in profile.objects.items() if addr in store}
-        self._read_control_word = store.reader(*profile.objects["control_word"])
+        self._read_control_word = store.integer_reader(*profile.objects["control_word"])
         self._active_handler: ModeHandler | None = None
         self._linked_bits = 0
         self.p: dict[str, Any] = {}
@@ -146,11 +148,13 @@ class DriveBehaviour:
         self._current_filter_alpha = 1.0
         self._velocity_filter = 0.0
         self._velocity_filter_alpha = 1.0
+        self._measure = self._measurement_functions()
         self.set_hardware_data()
         if commissioned:
             self.apply_commissioning()
         self._register_hooks()
         self.procedures = ProcedureRunner(self)
+        self.recorder = Recorder.for_store(store)
         self.write("supported_modes", profile.supported_modes_word)
         self.refresh_parameters()
         self.device_control.initialised()
@@ -436,6 +440,8 @@ class DriveBehaviour:
         if self.procedures.active is not None:
             self.procedures.end(ABORTED, raise_error=False)
         self.physics.power_cycle_sensor()
+        if self.recorder is not None:
+            self.recorder.reset()
         self.loops.measure()
         if self.plant.feedback == FEEDBACK_ENCODER:
             self.phasing_valid = False
@@ -482,6 +488,9 @@ class DriveBehaviour:
         loops.step()
         if periods % SLOW_PUBLISH_PERIODS == 0:
             self._publish_slow()
+        recorder = self.recorder
+        if recorder is not None and recorder.armed:
+            recorder.sample()  # after the period's update: the values a bus read would see now
 
     def _supervise(self) -> None:
         """Inputs, protections, current limit, brake and status word (every 1 ms and on each command)."""
@@ -699,9 +708,12 @@ class DriveBehaviour:
             else:
                 self._following_time = 0.0
         threshold = int(self.p.get("speed_error_threshold", U32_OFF))
-        if threshold != U32_OFF and loops.mode in (MODE_POSITION, MODE_VELOCITY):
-            if abs(units.speed_to_user(loops.speed_demand - loops.speed)) >= threshold:
-                self.raise_error(errors.SPEED_FOLLOWING)
+        if (
+            threshold != U32_OFF
+            and loops.mode in (MODE_POSITION, MODE_VELOCITY)
+            and abs(units.speed_to_user(loops.speed_demand - loops.speed)) >= threshold
+        ):
+            self.raise_error(errors.SPEED_FOLLOWING)
 
     # -- errors -------------------------------------------------------------------------------------------------
 
@@ -817,23 +829,27 @@ class DriveBehaviour:
             self._published_status = status
             self.write("status_word", status)
 
-    def _measurements(self) -> dict[str, Any]:
-        """The fast measurements in bus units (computed on every bus/PDO read, stored every 8 ms)."""
-        loops = self.loops
-        units = self.units
-        offset = self.position_offset_user
-        position = loops.position
-        demand = loops.position_ref if loops.mode == MODE_POSITION else position
+    def _measurement_functions(self) -> dict[str, Callable[[], int]]:
+        """The fast measurements in bus units (computed on every bus/PDO/recorder read, stored every 8 ms), one
+        function each: a read computes only its own object, which keeps an armed recorder cheap."""
         return {
-            "position_actual": _wrap_i32(units.to_user(position) + offset),
-            "velocity_actual": _wrap_i32(units.speed_to_user(self._velocity_filter)),
-            "position_demand": _wrap_i32(units.to_user(demand) + offset),
-            "following_error_actual": _wrap_i32(units.to_user(demand - position)),
-            "current_actual": _clamp_i16(1000.0 * self._current_filter / self.rated_current),
+            "position_actual": lambda: _wrap_i32(self.units.to_user(self.loops.position) + self.position_offset_user),
+            "velocity_actual": lambda: _wrap_i32(self.units.speed_to_user(self._velocity_filter)),
+            "position_demand": lambda: _wrap_i32(self.units.to_user(self._demand_rad()) + self.position_offset_user),
+            "following_error_actual": lambda: _wrap_i32(self.units.to_user(self._demand_rad() - self.loops.position)),
+            "current_actual": lambda: _clamp_i16(1000.0 * self._current_filter / self.rated_current),
         }
 
+    def _demand_rad(self) -> float:
+        loops = self.loops
+        return loops.position_ref if loops.mode == MODE_POSITION else loops.position
+
+    def _measurements(self) -> dict[str, int]:
+        return {name: measure() for name, measure in self._measure.items()}
+
     def _measurement_reader(self, name: str):
-        return lambda index, sub: self._measurements()[name]
+        measure = self._measure[name]
+        return lambda index, sub: measure()
 
     def _publish_slow(self) -> None:
         for name, value in self._measurements().items():
@@ -916,7 +932,7 @@ class DriveBehaviour:
 
 
 def _wrap_i32(value: float) -> int:
-    number = int(round(value)) & 0xFFFFFFFF
+    number = round(value) & 0xFFFFFFFF
     return number - (1 << 32) if number & 0x80000000 else number
 
 

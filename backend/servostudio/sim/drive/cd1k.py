@@ -1,4 +1,4 @@
-"""Infranor CD1-k on the shared engine (seed 001, /work/shared/spec/cd1k-canopen.md).
+"""Infranor CD1-k on the shared engine (manual 001, docs/devices.md).
 
 Differences from the XtrapulsPac that the simulation reproduces:
 - positions in increments with 0x608F,1 increments per revolution (no factor group), speeds inc/s;

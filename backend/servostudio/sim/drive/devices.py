@@ -1,7 +1,7 @@
 """Device families on the shared drive engine, and the factory the simulated node uses.
 
 XtrapulsPac is the reference; CD1-k and encoTRive reuse the engine with their own object addresses, scalings,
-error reporting and feature set (/work/shared/spec/cross-device.md).
+error reporting and feature set (docs/devices.md).
 """
 
 from __future__ import annotations

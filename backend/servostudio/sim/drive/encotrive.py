@@ -1,4 +1,4 @@
-"""TR-Electronic encoTRive MD-025 on the shared engine (seed 004, /work/shared/spec/encotrive-canopen.md).
+"""TR-Electronic encoTRive MD-025 on the shared engine (manual 004, docs/devices.md).
 
 A motor-integrated positioning drive: factory-calibrated commutation and loops (no phasing, tuning or current
 loop objects), profile position and profile velocity only, no homing (absolute measuring system), position

@@ -85,7 +85,8 @@ class Homing:
             return None
         method = self.method
         if method == 35:
-            return self._found(inputs.position)
+            self._found(inputs.position)
+            return None
         if method in (33, 34):
             return self._index_only(inputs, -1 if method == 33 else +1)
         if method in (1, 2, 17, 18):
@@ -98,9 +99,11 @@ class Homing:
 
     def _index_only(self, inputs: HomingInputs, direction: int) -> tuple[int, int] | None:
         if inputs.index_seen:
-            return self._found(inputs.index_position)
+            self._found(inputs.index_position)
+            return None
         if inputs.stalled or self._limit_ahead(inputs, direction):
-            return self._error()
+            self._error()
+            return None
         return direction, SLOW
 
     def _limit_switch(self, inputs: HomingInputs, towards: int, index: bool) -> tuple[int, int] | None:
@@ -111,13 +114,15 @@ class Homing:
             if active:
                 self._phase = "leave"
             elif inputs.stalled:
-                return self._error()
+                self._error()
+                return None
             else:
                 return towards, FAST
         if self._phase == "leave":
             if not active:
                 if not index:
-                    return self._found(inputs.position)
+                    self._found(inputs.position)
+                    return None
                 self._phase = "index"
             else:
                 return -towards, SLOW
@@ -130,7 +135,8 @@ class Homing:
             if not inputs.stalled:
                 return towards, FAST
             if not index:
-                return self._found(inputs.position)
+                self._found(inputs.position)
+                return None
             self._phase = "index"
             self.uses_current_limit = False
         return self._index_after_edge(inputs, -towards)
@@ -146,10 +152,12 @@ class Homing:
                 if self._limit_ahead(inputs, self._direction):
                     self._reversals += 1
                     if self._reversals > 1:
-                        return self._error()
+                        self._error()
+                        return None
                     self._direction = -self._direction
                 if inputs.stalled:
-                    return self._error()
+                    self._error()
+                    return None
                 return self._direction, FAST
         outwards = method.final_direction if self._is_exterior(method) else -method.final_direction
         if self._phase == "inside":
@@ -157,7 +165,8 @@ class Homing:
                 return outwards, SLOW if self._is_exterior(method) else FAST
             if self._is_exterior(method):
                 if not method.index:
-                    return self._found(inputs.position)
+                    self._found(inputs.position)
+                    return None
                 self._phase = "index"
             else:
                 self._phase = "back"
@@ -165,7 +174,8 @@ class Homing:
             if not inputs.home_switch:
                 return method.final_direction, SLOW
             if not method.index:
-                return self._found(inputs.position)
+                self._found(inputs.position)
+                return None
             self._phase = "index"
         return self._index_after_edge(inputs, method.final_direction)
 
@@ -181,9 +191,11 @@ class Homing:
             self._phase = "index_armed"
             return direction, SLOW  # an index latched before the edge does not count
         if inputs.index_seen:
-            return self._found(inputs.index_position)
+            self._found(inputs.index_position)
+            return None
         if inputs.stalled or self._limit_ahead(inputs, direction):
-            return self._error()
+            self._error()
+            return None
         return direction, SLOW
 
     @staticmethod
@@ -193,8 +205,6 @@ class Homing:
     def _found(self, position: float) -> None:
         self.home_position = position
         self.status = HomingStatus.FOUND
-        return
 
     def _error(self) -> None:
         self.status = HomingStatus.ERROR
-        return

@@ -338,10 +338,14 @@ class HomingMode(ModeHandler):
     def _step_homing(self) -> float:
         drive = self.drive
         homing = self.homing
-        units = drive.units
-        accel = units.accel_to_rad(float(drive.p.get("homing_acceleration", 0))) or 1.0
+        accel = drive.units.accel_to_rad(float(drive.p.get("homing_acceleration", 0))) or 1.0
         if homing is None or homing.status is not HomingStatus.RUNNING:
             return self.ramp.step(0.0, accel, accel)
+        return self._follow_homing(homing, self._homing_move(homing), accel)
+
+    def _homing_move(self, homing: Homing) -> tuple[int, int] | None:
+        """One step of the running homing method against the drive's inputs; the step may end the run."""
+        drive = self.drive
         physics = drive.physics
         loops = drive.loops
         stalled_now = loops.current_limited and abs(loops.speed) < 0.2 * abs(self.ramp.velocity) + 0.05
@@ -363,6 +367,11 @@ class HomingMode(ModeHandler):
             self.position_ref = loops.position
             self.ramp.velocity = 0.0
             self._stall_time = 0.0
+        return move
+
+    def _follow_homing(self, homing: Homing, move: tuple[int, int] | None, accel: float) -> float:
+        """The ramp's velocity for the homing step's outcome (a separate function: the step changed the status)."""
+        drive = self.drive
         if homing.status is HomingStatus.FOUND:
             self._found(homing.home_position)
             return self.ramp.step(0.0, accel, accel)
@@ -373,7 +382,7 @@ class HomingMode(ModeHandler):
             return self.ramp.step(0.0, accel, accel)
         direction, speed_class = move
         name = "homing_speed_fast" if speed_class == FAST else "homing_speed_slow"
-        speed = min(units.speed_to_rad(float(drive.p.get(name, 0))), drive.max_speed)
+        speed = min(drive.units.speed_to_rad(float(drive.p.get(name, 0))), drive.max_speed)
         return self.ramp.step(direction * speed, accel, accel)
 
     def _found(self, home_rad: float) -> None:

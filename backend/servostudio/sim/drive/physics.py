@@ -108,15 +108,18 @@ class AxisPhysics:
         """Currents as the drive sees them in its own frame (inverse of the drive → rotor mapping).
 
         Also fixes the frame for the following `step` (the state does not change in between)."""
-        plant = self.plant
-        s = phase_sign * self._phase_sign
-        delta = s * theta_hat - TWO_PI * (plant.pole_pairs * self.theta_motor / TWO_PI + plant.sensor_offset / 65536.0)
-        c = math.cos(delta)
-        sn = math.sin(delta)
-        self._frame = (c, sn, s)
+        c, sn, s = self._fix_frame(theta_hat, phase_sign)
         i_d = self.i_d
         i_q = self.i_q
         return c * i_d + sn * i_q, s * (-sn * i_d + c * i_q)
+
+    def _fix_frame(self, theta_hat: float, phase_sign: int) -> tuple[float, float, int]:
+        """The drive → rotor frame of this period (cosine and sine of the angle error, phase sign), kept for `step`."""
+        plant = self.plant
+        s = phase_sign * self._phase_sign
+        delta = s * theta_hat - TWO_PI * (plant.pole_pairs * self.theta_motor / TWO_PI + plant.sensor_offset / 65536.0)
+        frame = self._frame = (math.cos(delta), math.sin(delta), s)
+        return frame
 
     def step(self, v_d_hat: float, v_q_hat: float, theta_hat: float, phase_sign: int) -> None:
         """Apply the drive-frame voltages for one period and advance everything.
@@ -128,8 +131,7 @@ class AxisPhysics:
         if self.power_stage_on:
             frame = self._frame
             if frame is None:
-                self.measured_currents(theta_hat, phase_sign)
-                frame = self._frame
+                frame = self._fix_frame(theta_hat, phase_sign)
             c, sn, s = frame
             vq_m = s * v_q_hat
             v_d = c * v_d_hat - sn * vq_m

@@ -17,6 +17,7 @@ at the next file; a cancelled upload changes nothing in the project.
 
 from __future__ import annotations
 
+import logging
 import shutil
 import tempfile
 from collections.abc import Callable, Iterable, Mapping
@@ -25,6 +26,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from servostudio.drive.access import Drive
+from servostudio.errors import ServoStudioError
 from servostudio.formats.objectfile import ObjectEntry, format_object_file, write_object_file
 from servostudio.services.backup import FileKind, backup_drive, drive_file_kinds, restore_file
 from servostudio.services.bus import ConnectionManager
@@ -36,6 +38,7 @@ from servostudio.services.projects.live.links import AxisLink, link_axes
 from servostudio.services.projects.parameter_values import to_file_value
 from servostudio.services.projects.service import ProjectService
 
+log = logging.getLogger(__name__)
 Progress = Callable[[dict[str, object]], None]
 DIRECTIONS = ("check", "download", "upload")
 
@@ -257,7 +260,9 @@ def _parallel(reports: list[AxisReport], work: Callable[[AxisReport], None]) -> 
         for report, future in futures:
             try:
                 future.result()
-            except Exception as error:  # reported per axis; the other axes go on
+            except Exception as error:  # reported per axis; the other axes go on; a bug is logged as well
+                if not isinstance(error, ServoStudioError):
+                    log.exception("commission of axis %s failed unexpectedly", report.link.axis.name)
                 report.error = str(error)
 
 

@@ -95,12 +95,12 @@ def link_axes(
         raise ProjectNotFound(f"project '{project.name}' has no bus {', '.join(sorted(unknown))}")
     connections: dict[str, tuple[str, BusConnection]] = {}
     for axis in axes:
-        bus = project.bus(axis.bus)
+        bus = project.bus_of(axis)
         if bus.name not in connections:
             spec = overrides.get(bus.name, bus.interface)
             connections[bus.name] = (spec, open_bus(manager, bus, spec))
     with ThreadPoolExecutor(max_workers=max(1, len(axes)), thread_name_prefix="identify") as pool:
-        return list(pool.map(lambda axis: _link(project.bus(axis.bus), axis, *connections[axis.bus]), axes))
+        return list(pool.map(lambda axis: _link(project.bus_of(axis), axis, *connections[axis.bus]), axes))
 
 
 def link_axis(

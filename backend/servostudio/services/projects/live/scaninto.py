@@ -78,7 +78,7 @@ def scan_into_project(
     for info in found:
         result = _place(candidate, chosen, info, service.library.devices())
         nodes.append(result)
-        if result.status == "added":
+        if result.status == "added" and result.axis is not None and info.device is not None:
             axis = Axis(result.axis, info.device, info.node, chosen.name)
             candidate = candidate.with_axes((*candidate.axes, axis))
             new_axes.append(axis)

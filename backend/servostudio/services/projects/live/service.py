@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from collections.abc import Iterable, Mapping, Sequence
 
-from servostudio.services.bus import ConnectionManager
+from servostudio.services.bus import ConnectionManager, Job, JobRegistry
 from servostudio.services.cancel import Cancellation
 from servostudio.services.projects.live.commission import CommissionReport, Progress, commission
 from servostudio.services.projects.live.links import AxisLink, link_axis
@@ -83,6 +83,23 @@ class LiveProjects:
         return commission(
             self.projects, self.connections, project, direction, axes, buses, expected_revision, progress, cancel
         )
+
+    def start_commission(
+        self,
+        jobs: JobRegistry,
+        project: str,
+        direction: str = "check",
+        axes: Iterable[str] | None = None,
+        expected_revision: str | None = None,
+    ) -> Job:
+        """Commission as a cancellable job (progress events); an unknown project is refused now, not in the job."""
+        self.projects.store.open(project)
+
+        def work(progress: Progress, cancel: Cancellation) -> object:
+            report = self.commission(project, direction, axes, expected_revision, progress=progress, cancel=cancel)
+            return report.as_dict()
+
+        return jobs.start(f"commission-{direction}", work)
 
     def scan(
         self,

@@ -29,7 +29,7 @@ class DriveValues:
         self.refused: dict[Key, str] = {}  # object -> the drive's reason (SDO abort)
         readable = [var for var in variables if var.access.readable]
         outcomes = drive.submit_read_all(readable).future.result(DEFAULT_WAIT)
-        for variable, outcome in zip(readable, outcomes):
+        for variable, outcome in zip(readable, outcomes, strict=True):
             if isinstance(outcome, SdoAbortError):
                 self.refused[variable.key] = outcome.reason
             elif isinstance(outcome, ValueError):

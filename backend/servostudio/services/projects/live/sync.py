@@ -132,18 +132,14 @@ def write_to_drive(
         for address in addresses:
             row, _revision = parameters.get(project, axis, address)
             chosen.append((row.variable, row.value))
-    writes = [DriveWrite(variable, value) for variable, value in chosen]
+    writes = [DriveWrite(variable, _project_value(variable, value)) for variable, value in chosen]
     for write in writes:  # everything is checked before the first frame is sent
-        if write.value is None:
-            raise ParameterRefused(
-                f"{write.variable.label}: the project has no value for it (no default, not set); nothing was written"
-            )
         try:
             drive.prepare_write(write.variable, write.value)
         except DriveAccessError as error:
             raise ParameterRefused(f"{error}; nothing was written") from None
     batch = drive.submit_write_all([(write.variable, write.value) for write in writes])
-    for write, outcome in zip(writes, batch.future.result(DEFAULT_WAIT)):
+    for write, outcome in zip(writes, batch.future.result(DEFAULT_WAIT), strict=True):
         if isinstance(outcome, SdoAbortError):
             write.status, write.error = "failed", outcome.reason
         elif isinstance(outcome, Exception):  # no answer: the first such write ended the batch
@@ -164,3 +160,11 @@ def _resolve(parameters: ParameterService, project: str, axis: str, addresses: S
     if not addresses:
         raise ParameterRefused("no object given")
     return [parameters.get(project, axis, address)[0].variable for address in addresses]
+
+
+def _project_value(variable: Variable, value: Value | None) -> Value:
+    if value is None:
+        raise ParameterRefused(
+            f"{variable.label}: the project has no value for it (no default, not set); nothing was written"
+        )
+    return value

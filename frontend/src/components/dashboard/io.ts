@@ -1,0 +1,47 @@
+/** Digital I/O (0x60FD inputs, 0x60FE,1 outputs) as LEDs named by their bit fields. */
+
+import { extractBits, fieldLabel } from "../../lib/bits";
+import { h } from "../../lib/dom";
+import type { Entry } from "../../lib/od";
+
+export interface DigitalIoProps {
+  inputs: Entry | null;
+  outputs: Entry | null;
+  /** The live word of an entry (null until it arrived); read inside bindings. */
+  word(entry: Entry): number | null;
+  address(entry: Entry): string;
+}
+
+export function digitalIo(props: DigitalIoProps): HTMLElement {
+  const groups: HTMLElement[] = [];
+  if (props.inputs) groups.push(ioGroup("Inputs", props.inputs, props));
+  if (props.outputs) groups.push(ioGroup("Outputs", props.outputs, props));
+  return h("section", { class: "panel" }, h("h2", null, "Digital I/O"),
+    h("div", { class: "panel-body" }, groups.length ? groups : h("div", { class: "muted" }, "This dictionary has no digital I/O objects.")));
+}
+
+function ioGroup(title: string, entry: Entry, props: DigitalIoProps): HTMLElement {
+  const word = () => props.word(entry);
+  return h("div", { style: { marginBottom: "8px" } },
+    h("div", { class: "muted", style: { marginBottom: "4px" } }, `${title} · ${props.address(entry)}`, () => {
+      const value = word();
+      return value === null ? "" : ` = 0x${value.toString(16).toUpperCase().padStart(8, "0")}`;
+    }),
+    h("div", { class: "io-row", "data-testid": `io-${title.toLowerCase()}` }, entry.variable.bits.map((field) => h("span", {
+      class: () => {
+        const value = word();
+        return `led ${value !== null && extractBits(value, field.first, field.last) !== 0 ? "on" : ""}`;
+      },
+      title: `bit ${fieldLabel(field)}: ${field.name}`,
+    }, shortName(field.name)))));
+}
+
+/** A short LED label from a bit name: "IN1", "Negative limit switch" → "LIM−", "Home switch" → "Home". */
+export function shortName(name: string): string {
+  const match = /\b(IN|OUT)\s*(\d+)\b/i.exec(name);
+  if (match) return `${match[1].toUpperCase()}${match[2]}`;
+  if (/negative limit/i.test(name)) return "LIM−";
+  if (/positive limit/i.test(name)) return "LIM+";
+  const words = name.split(/[\s/(),]+/).filter(Boolean);
+  return words.length ? words[0].slice(0, 8) : name;
+}

@@ -1,0 +1,68 @@
+/**
+ * Quick test · profile velocity (manual §1.8.19): acceleration, deceleration and target velocity in their units;
+ * Set mode and run checks all three and hands them on, Stop writes target 0.
+ */
+
+import { numberEditor, type ValueEditor } from "../editors";
+import { h, type Bindable } from "../../lib/dom";
+import type { Entry, Scalar } from "../../lib/od";
+
+export interface QuickTestValue {
+  entry: Entry;
+  raw: number | string;
+  /** As typed (for the confirmation). */
+  text: string;
+}
+
+export interface QuickTestProps {
+  acceleration: Entry | null;
+  deceleration: Entry | null;
+  target: Entry;
+  /** The drive's value of a field's entry (shown until the user types). */
+  value(entry: Entry): Bindable<Scalar>;
+  onRun(values: QuickTestValue[]): void;
+  /** Write target 0; true when written (the target field then shows the drive's value again). */
+  onStop(): Promise<boolean>;
+  /** A field's text was refused: `<name>: <reason>`. */
+  onRefuse(message: string): void;
+}
+
+interface Field {
+  entry: Entry;
+  label: string;
+  editor: ValueEditor;
+}
+
+export function quickTest(props: QuickTestProps): HTMLElement {
+  const field = (entry: Entry | null, label: string, testid: string): Field | null => entry && {
+    entry, label,
+    editor: numberEditor(entry.variable, {
+      value: props.value(entry),
+      attrs: { style: { width: "110px" }, "data-testid": testid, "aria-label": label },
+    }),
+  };
+  const target = field(props.target, "Target velocity", "qt-velocity")!;
+  const fields = [field(props.acceleration, "Acceleration", "qt-acceleration"), field(props.deceleration, "Deceleration", "qt-deceleration"), target]
+    .filter((candidate): candidate is Field => candidate !== null);
+  const run = () => {
+    const values: QuickTestValue[] = [];
+    for (const { entry, editor } of fields) {
+      const parsed = editor.submit();
+      if (!parsed.ok) return props.onRefuse(`${entry.variable.name}: ${parsed.error}`);
+      values.push({ entry, raw: parsed.raw, text: editor.text.rawVal });
+    }
+    props.onRun(values);
+  };
+  const stop = async () => {
+    if (await props.onStop()) target.editor.revert();
+  };
+  return h("section", { class: "panel" },
+    h("h2", null, "Quick test · profile velocity"),
+    h("div", { class: "panel-body grid", style: { gap: "8px" } },
+      h("div", { class: "toolbar" }, fields.map(({ entry, label, editor }) =>
+        h("label", { class: "field" }, `${label} [${entry.variable.unit}]`, editor.element))),
+      h("div", { class: "toolbar" },
+        h("button", { class: "primary", "data-testid": "qt-run", onclick: run }, "Set mode and run"),
+        h("button", { "data-testid": "qt-stop", onclick: () => void stop() }, "Stop (target 0)"),
+        h("span", { class: "muted" }, "Runs only while the drive is in Operation enabled."))));
+}

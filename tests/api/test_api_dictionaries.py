@@ -1,0 +1,65 @@
+"""Dictionaries through REST: browse the built-in library, import a user EDS, refuse a bad one; the caller."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+from fastapi.testclient import TestClient
+from tests.support.small_eds import SMALL_EDS, SMALL_PROPS, write_small_eds
+
+from servostudio.api.app import Settings, create_app
+
+
+@pytest.fixture
+def client(tmp_path: Path) -> TestClient:
+    return TestClient(create_app(Settings(projects_dir=tmp_path, user_eds_dir=tmp_path / "user-eds")))
+
+
+def test_builtin_xtrapulspac_is_listed_and_browsable(client: TestClient) -> None:
+    devices = {entry["device"]: entry for entry in client.get("/api/dictionaries").json()}
+    assert devices["xtrapulspac"]["builtin"] is True
+    od = client.get("/api/dictionaries/xtrapulspac").json()
+    objects = {obj["index"]: obj for obj in od["objects"]}
+    statusword = objects[0x6041]["subs"][0]
+    assert statusword["data_type"] == "UNSIGNED16"
+    assert statusword["access"].startswith("r")
+    assert statusword["bits"], "the status word's bits are described in the companion file"
+    assert any(sub["name"] for sub in objects[0x60F9]["subs"])
+    assert "Servo Loops" in od["groups"]
+
+
+def test_unknown_dictionary_is_404_naming_the_known_ones(client: TestClient) -> None:
+    response = client.get("/api/dictionaries/nosuchdrive")
+    assert response.status_code == 404
+    assert "xtrapulspac" in response.json()["detail"]
+
+
+def test_import_user_eds_over_rest(client: TestClient, tmp_path: Path) -> None:
+    eds = write_small_eds(tmp_path)
+    response = client.post(
+        "/api/dictionaries",
+        files={"eds": ("acme.eds", eds.read_bytes()), "props": ("acme.props", SMALL_PROPS.encode())},
+    )
+    assert response.status_code == 201, response.text
+    assert response.json()["builtin"] is False
+    od = client.get("/api/dictionaries/acme").json()
+    speed = next(obj for obj in od["objects"] if obj["index"] == 0x2000)["subs"][0]
+    assert (speed["low"], speed["high"], speed["unit"], speed["save_type"]) == (10, 6000, "rpm", "DRIVEPAR")
+    assert (tmp_path / "user-eds" / "acme.eds").is_file()
+
+
+def test_bad_eds_is_refused_with_line_and_nothing_kept(client: TestClient, tmp_path: Path) -> None:
+    broken = SMALL_EDS.replace(
+        "DataType=0x0006\nAccessType=rw\nLowLimit=10", "DataType=0x0006\nAccessType=rw\nLowLimit=-10"
+    )
+    response = client.post("/api/dictionaries", files={"eds": ("acme.eds", broken.encode())})
+    assert response.status_code == 422
+    detail = response.json()["detail"]
+    line = broken.splitlines().index("LowLimit=-10") + 1
+    assert detail.startswith(f"acme.eds:{line}: [2000]"), detail
+    assert not (tmp_path / "user-eds" / "acme.eds").exists()
+
+
+def test_me_names_the_caller_and_level(client: TestClient) -> None:
+    assert client.get("/api/me").json() == {"name": "local", "level": "administrator"}
