@@ -17,4 +17,5 @@ RUN pip install --no-cache-dir -e .
 COPY projects/ /app/projects/
 EXPOSE 8000
 # Inside the container the server must listen on all interfaces; docker-compose publishes it on localhost only.
+# That needs users in the data directory ($SERVOSTUDIO_DATA_DIR): `servostudio user add NAME --level administrator`.
 CMD ["servostudio", "serve", "--host", "0.0.0.0", "--allow-remote", "--port", "8000", "--projects", "/app/projects"]

@@ -4,7 +4,7 @@
  * Pages are plain modules that build their element from a `PageContext` (`pages/index.ts`).
  */
 
-import { getHealth, getMe, projects, type Project } from "./client/api";
+import { ApiError, getHealth, getMe, onUnauthenticated, projects, type Project, type UserInfo } from "./client/api";
 import { driveApi, learnBuses } from "./client/drives";
 import { LiveHub } from "./client/live";
 import { projectTree } from "./components/shell/tree";
@@ -31,6 +31,8 @@ export interface Page {
   dispose?(): void;
   /** Focus the page's search field (shortcut `/`); false when the page has none. */
   focusSearch?(): boolean;
+  /** Run a shortcut of the page itself (the scope's arm, force, stop); false when the page has none. */
+  shortcut?(action: string): boolean;
 }
 
 export interface PageContext {
@@ -65,6 +67,7 @@ export class App {
       h("main", { class: "main" }, () => this.content.val)));
     document.addEventListener("click", (event) => this.onClick(event));
     installShortcuts(this);
+    onUnauthenticated(() => this.requireLogin());
     window.addEventListener("popstate", () => this.show(parsePath(window.location.pathname, window.location.search)));
   }
 
@@ -114,6 +117,11 @@ export class App {
     return this.page?.focusSearch?.() ?? false;
   }
 
+  /** A shortcut only the current page knows (shortcuts.ts asks after its own). */
+  pageShortcut(action: string): boolean {
+    return this.page?.shortcut?.(action) ?? false;
+  }
+
   private show(location: Location): void {
     const previous = this.location;
     this.here.val = location;
@@ -154,6 +162,25 @@ export class App {
     this.show(parsePath(url.pathname, url.search));
   }
 
+  // ---- logging in ---------------------------------------------------------------------------------------------
+
+  /** Nobody is logged in, or the session ended: the login page, which comes back here afterwards. */
+  private requireLogin(): void {
+    const page = this.location.route.page;
+    if (page === "login" || page === "setup") return;
+    this.navigate({ page: "login" }, { next: window.location.pathname + window.location.search }, true);
+  }
+
+  /** After a login or the setup: the user in the top bar, what it may now see, and the page it was going to. */
+  signedIn(user: UserInfo): void {
+    this.live.setUser(user);
+    const next = new URL(this.location.query.next ?? "/", window.location.origin);
+    const target = next.origin === window.location.origin ? next : new URL("/", window.location.origin);
+    history.replaceState(null, "", target.pathname + target.search);
+    this.show(parsePath(target.pathname, target.search));
+    void this.refreshProjects();
+  }
+
   // ---- projects and buses -------------------------------------------------------------------------------------
 
   /** Reload the projects shown in the tree (after create, rename, add axis…). */
@@ -164,7 +191,7 @@ export class App {
       this.projectsError.val = null;
     } catch (error) {
       this.projects.val = [];
-      this.projectsError.val = errorText(error);
+      this.projectsError.val = error instanceof ApiError && error.status === 401 ? "Log in to see the projects." : errorText(error);
     }
     this.projectsKnown = true;
     this.resolveProjects();

@@ -19,6 +19,7 @@ const AXIS_VIEWS: Record<string, AxisView> = {
   "go-parameters": "parameters",
   "go-commissioning": "commissioning",
   "go-backup": "backup",
+  "go-scope": "scope",
 };
 
 /** Listen to the keyboard: shortcuts are ignored while typing in a field, where Escape leaves the field. */
@@ -44,7 +45,7 @@ export function runAction(app: App, action: string): boolean {
   else if (action in PAGES) app.navigate(PAGES[action]);
   else if (action in AXIS_VIEWS) goAxis(app, AXIS_VIEWS[action]);
   else if (action === "previous-axis" || action === "next-axis") return stepAxis(app, action === "next-axis" ? 1 : -1);
-  else return false;
+  else return app.pageShortcut(action);
   return true;
 }
 

@@ -1,10 +1,10 @@
 """The communication server's HTTP surface: health, OpenAPI, docs, UI."""
 
 import httpx
-from fastapi.testclient import TestClient
+from tests.support.access import admin_app, api_client
 
 from servostudio import __version__
-from servostudio.api.app import Settings, create_app
+from servostudio.api.app import Settings
 
 
 def test_health_over_real_http(live_server) -> None:
@@ -32,14 +32,14 @@ def test_static_fallback_never_escapes_the_static_dir(tmp_path) -> None:
     static.mkdir()
     (static / "index.html").write_text("<title>shell</title>")
     (tmp_path / "secret.txt").write_text("top secret")
-    client = TestClient(create_app(Settings(projects_dir=tmp_path, static_dir=static)))
+    client = api_client(admin_app(Settings(projects_dir=tmp_path, static_dir=static), tmp_path / "data"))
     response = client.get("/..%2Fsecret.txt")
     assert "top secret" not in response.text
     assert "<title>shell</title>" in response.text
 
 
 def test_missing_ui_build_says_how_to_build_it(tmp_path) -> None:
-    client = TestClient(create_app(Settings(projects_dir=tmp_path, static_dir=tmp_path / "none")))
+    client = api_client(admin_app(Settings(projects_dir=tmp_path, static_dir=tmp_path / "none"), tmp_path / "data"))
     response = client.get("/")
     assert response.status_code == 503
     assert "make run" in response.text

@@ -8,7 +8,7 @@ import time
 import httpx
 import pytest
 import uvicorn
-from fastapi.testclient import TestClient
+from tests.support.access import admin_app, api_client, bearer, token
 
 from servostudio.api.app import Settings, create_app
 
@@ -16,8 +16,9 @@ from servostudio.api.app import Settings, create_app
 @pytest.fixture(scope="module")
 def client(socketcand, tmp_path_factory):
     projects, exports = tmp_path_factory.mktemp("projects"), tmp_path_factory.getbasetemp()  # tests' tmp_path
-    app = create_app(Settings(projects_dir=projects, export_dir=exports, buses=[socketcand.spec]))
-    with TestClient(app) as test_client:
+    settings = Settings(projects_dir=projects, export_dir=exports, buses=[socketcand.spec])
+    app = admin_app(settings, tmp_path_factory.mktemp("data"))
+    with api_client(app) as test_client:
         deadline = time.monotonic() + 5
         while not test_client.get("/api/buses").json()[0]["connected"] and time.monotonic() < deadline:
             time.sleep(0.05)
@@ -52,6 +53,7 @@ def test_read_write_and_refusals(client):
 def test_state_and_faults(client):
     with client.websocket_connect("/api/ws/events?types=job") as socket:
         motion_client = {"X-Servo-Client": socket.receive_json()["client"]}
+        assert client.post("/api/buses/socketcand/nodes/2/control/arm", headers=motion_client).status_code == 200
         enabled = client.put(
             "/api/buses/socketcand/nodes/2/state", json={"target": "operation-enabled"}, headers=motion_client
         ).json()
@@ -120,7 +122,7 @@ def test_terminal_watch_read_and_write(client):
 
 
 def test_real_http_through_uvicorn(socketcand, tmp_path):
-    app = create_app(Settings(projects_dir=tmp_path, buses=[socketcand.spec]))
+    app = create_app(Settings(projects_dir=tmp_path, buses=[socketcand.spec], data_dir=tmp_path / "data"))
     server = uvicorn.Server(uvicorn.Config(app, host="127.0.0.1", port=0, log_level="warning"))
     thread = threading.Thread(target=server.run, daemon=True)
     thread.start()
@@ -129,7 +131,8 @@ def test_real_http_through_uvicorn(socketcand, tmp_path):
         while not (server.started and server.servers) and time.monotonic() < deadline:
             time.sleep(0.05)
         port = server.servers[0].sockets[0].getsockname()[1]
-        with httpx.Client(base_url=f"http://127.0.0.1:{port}", timeout=10) as http:
+        headers = bearer(token(tmp_path / "data"))  # a script with an API token
+        with httpx.Client(base_url=f"http://127.0.0.1:{port}", headers=headers, timeout=10) as http:
             while not http.get("/api/buses").json()[0]["connected"] and time.monotonic() < deadline:
                 time.sleep(0.05)
             assert [node["node"] for node in http.post("/api/buses/socketcand/scan").json()] == [1, 2, 3]
@@ -149,17 +152,21 @@ def test_enabling_needs_a_live_client_and_its_axes_stop_when_it_goes(client):
         headers={"X-Servo-Client": "not-a-connected-client"},
     )
     assert forged.status_code == 409
+    # one command from enabled: a control word 0x0F would enable it
+    assert client.put("/api/buses/socketcand/nodes/3/state", json={"target": "switched-on"}).status_code == 200
     raw_enable = client.put("/api/buses/socketcand/nodes/3/objects/controlword", json={"value": 0x0F})
     assert raw_enable.status_code == 409 and "live client" in raw_enable.json()["detail"]
     with client.websocket_connect("/api/ws/terminal") as terminal:
         terminal.send_json({"op": "write", "bus": "socketcand", "node": 3, "object": "controlword", "value": 15})
         answer = terminal.receive_json()
         assert answer["type"] == "error" and "live client" in answer["detail"]
-    assert client.get("/api/buses/socketcand/nodes/3/state").json()["state"] == "SWITCH ON DISABLED"
+    assert client.get("/api/buses/socketcand/nodes/3/state").json()["state"] == "SWITCHED ON"
 
     with client.websocket_connect("/api/ws/events?types=job") as socket:
         hello = socket.receive_json()
         assert hello["type"] == "hello"
+        arming = client.post("/api/buses/socketcand/nodes/3/control/arm", headers={"X-Servo-Client": hello["client"]})
+        assert arming.json()["holder"]["client"] == hello["client"]
         enabled = client.put(
             "/api/buses/socketcand/nodes/3/state",
             json={"target": "operation-enabled"},

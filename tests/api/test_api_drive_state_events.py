@@ -6,9 +6,9 @@ from __future__ import annotations
 import threading
 import time
 
-from fastapi.testclient import TestClient
+from tests.support.access import admin_app, api_client
 
-from servostudio.api.app import create_app
+from servostudio.api.app import Settings
 
 WAIT = 10.0
 
@@ -20,9 +20,9 @@ def _next_state(socket, node: int) -> dict:
             return event
 
 
-def test_state_change_by_control_word_is_published():
-    app = create_app()
-    with TestClient(app) as client:
+def test_state_change_by_control_word_is_published(tmp_path):
+    app = admin_app(Settings(), tmp_path)
+    with api_client(app) as client:
         client.post("/api/buses", json={"spec": "sim"})
         hub = app.state.server.connections.events
         # A watchdog event ends the wait if the expected one never comes (receive_json has no timeout).
@@ -43,9 +43,9 @@ def test_state_change_by_control_word_is_published():
             watchdog.cancel()
 
 
-def test_no_polling_without_a_listener():
-    app = create_app()
-    with TestClient(app) as client:
+def test_no_polling_without_a_listener(tmp_path):
+    app = admin_app(Settings(), tmp_path)
+    with api_client(app) as client:
         client.post("/api/buses", json={"spec": "sim"})
         hub = app.state.server.connections.events
         assert not hub.wants("drive_state")

@@ -4,12 +4,11 @@ request id (never a 422). The kind → status table itself is `servostudio.error
 
 from __future__ import annotations
 
-import io
 import logging
-import zipfile
 
 import pytest
 from fastapi.testclient import TestClient
+from tests.support.access import admin_app, api_client, bearer, token
 
 import servostudio.cli
 from servostudio.api.app import Settings, create_app
@@ -17,7 +16,7 @@ from servostudio.api.errors import REQUEST_ID_HEADER
 from servostudio.api.routes import buses as bus_routes
 from servostudio.api.routes import projects as project_routes
 from servostudio.errors import OUTCOMES, ErrorKind, ServoStudioError
-from servostudio.services.projects import ArchiveLimits
+from servostudio.services.users import Level
 
 SILENT = "/api/buses/sim/nodes/42"  # no drive answers there; ?device= gives it a dictionary all the same
 
@@ -25,8 +24,8 @@ SILENT = "/api/buses/sim/nodes/42"  # no drive answers there; ?device= gives it 
 @pytest.fixture(scope="module")
 def client(tmp_path_factory):
     root = tmp_path_factory.mktemp("errors")
-    app = create_app(Settings(projects_dir=root / "projects", static_dir=root / "no-ui", buses=("sim",)))
-    with TestClient(app) as client:
+    app = admin_app(Settings(projects_dir=root / "projects", static_dir=root / "no-ui", buses=("sim",)), root / "data")
+    with api_client(app) as client:
         yield client
 
 
@@ -56,13 +55,10 @@ def test_malformed_request_keeps_fastapis_problem_list(client):
     assert body["detail"][0]["loc"] == ["body", "spec"]
 
 
-def test_too_large(client, monkeypatch):
-    monkeypatch.setattr(project_routes, "ArchiveLimits", lambda: ArchiveLimits(max_total_bytes=1000))
-    archive = io.BytesIO()
-    with zipfile.ZipFile(archive, "w") as packed:
-        packed.writestr("p/project.toml", "x" * 5000)
-    answer = client.post("/api/projects/unarchive", content=archive.getvalue())
-    assert "larger than 1000 bytes" in refusal(answer, 413, ErrorKind.TOO_LARGE, "ArchiveTooLarge")
+def test_too_large(client):
+    answer = client.post("/api/projects/unarchive", content=bytes(project_routes.ARCHIVE_UPLOAD_BYTES + 1))
+    detail = refusal(answer, 413, ErrorKind.TOO_LARGE, "BodyTooLarge")
+    assert f"limit of {project_routes.ARCHIVE_UPLOAD_BYTES} bytes" in detail
 
 
 def test_conflict(client):
@@ -90,6 +86,18 @@ def test_unavailable(client):
     answer = client.get("/api/buses/gone/nodes/1/objects/0x1000", params={"device": "xtrapulspac"})
     refusal(answer, 503, ErrorKind.UNAVAILABLE, "SdoLinkError")
     assert client.delete("/api/buses/gone").status_code == 204
+
+
+def test_unauthenticated_forbidden_and_rate_limited(client):
+    anonymous = TestClient(client.app)
+    refusal(anonymous.get("/api/buses"), 401, ErrorKind.UNAUTHENTICATED, "NotLoggedIn")
+    operator = bearer(token(client.app.state.server.settings.data_dir, Level.OPERATOR))
+    answer = client.post("/api/buses/sim/nmt", json={"command": "start", "node": 1}, headers=operator)
+    assert "needs the expert level" in refusal(answer, 403, ErrorKind.FORBIDDEN, "LevelTooLow")
+    for _ in range(5):
+        anonymous.post("/api/session", json={"name": "nobody", "password": "wrong"})
+    answer = anonymous.post("/api/session", json={"name": "nobody", "password": "wrong"})
+    refusal(answer, 429, ErrorKind.RATE_LIMITED, "TooManyLogins")
 
 
 @pytest.mark.parametrize("bug", [ValueError("a programming error"), KeyError("missing")])

@@ -7,17 +7,17 @@ from __future__ import annotations
 from concurrent.futures import ThreadPoolExecutor
 
 import pytest
-from fastapi.testclient import TestClient
+from tests.support.access import admin_app, api_client
 
-from servostudio.api.app import create_app
+from servostudio.api.app import Settings
 from servostudio.services.bus import NodeInfo
 
 
 @pytest.fixture
-def fresh():
+def fresh(tmp_path):
     """A new server with the sim bus just opened (nothing scanned)."""
-    app = create_app()
-    with TestClient(app) as client:
+    app = admin_app(Settings(), tmp_path)
+    with api_client(app) as client:
         assert client.post("/api/buses", json={"spec": "sim"}).json()["nodes"] == []
         yield app, client
 

@@ -12,8 +12,9 @@ from pathlib import Path
 
 import pytest
 from fastapi.testclient import TestClient
+from tests.support.access import admin_app, api_client
 
-from servostudio.api.app import Settings, create_app
+from servostudio.api.app import Settings
 from servostudio.formats.objectfile import ObjectEntry, read_object_file, write_object_file
 
 WAIT = 20.0
@@ -21,8 +22,9 @@ WAIT = 20.0
 
 @pytest.fixture(scope="module")
 def app_client(tmp_path_factory):
-    app = create_app(Settings(export_dir=tmp_path_factory.getbasetemp()))  # backups go to the tests' tmp_path
-    with TestClient(app) as client:
+    settings = Settings(export_dir=tmp_path_factory.getbasetemp())  # backups go to the tests' tmp_path
+    app = admin_app(settings, tmp_path_factory.mktemp("data"))
+    with api_client(app) as client:
         assert client.post("/api/buses", json={"spec": "sim"}).status_code == 201
         yield app, client
 

@@ -8,13 +8,15 @@ from pathlib import Path
 
 import pytest
 from fastapi.testclient import TestClient
+from tests.support.access import admin_app, api_client
 
-from servostudio.api.app import Settings, create_app
+from servostudio.api.app import Settings
 
 
 @pytest.fixture
 def client(tmp_path: Path) -> TestClient:
-    return TestClient(create_app(Settings(projects_dir=tmp_path / "projects", user_eds_dir=tmp_path / "eds")))
+    settings = Settings(projects_dir=tmp_path / "projects", user_eds_dir=tmp_path / "eds")
+    return api_client(admin_app(settings, tmp_path / "data"))
 
 
 def _project_with_axis(client: TestClient) -> str:

@@ -6,15 +6,16 @@ import time
 
 import pytest
 from fastapi.testclient import TestClient
+from tests.support.access import admin_app, api_client
 
-from servostudio.api.app import Settings, create_app
+from servostudio.api.app import Settings
 
 
 @pytest.fixture(scope="module")
 def client(tmp_path_factory, sim_opener):
     root = tmp_path_factory.mktemp("api-store")
-    app = create_app(Settings(projects_dir=root / "store", static_dir=root / "no-ui", buses=["sim"]))
-    with TestClient(app) as test_client:
+    app = admin_app(Settings(projects_dir=root / "store", static_dir=root / "no-ui", buses=["sim"]), root / "data")
+    with api_client(app) as test_client:
         sim_opener(app.state.server.connections)
         yield test_client
 

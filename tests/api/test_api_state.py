@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from fastapi.testclient import TestClient
+from tests.support.access import admin_app, api_client
 
 from servostudio.api.app import Settings, create_app
 from servostudio.api.state import ServerState
@@ -24,9 +24,9 @@ def test_the_state_is_built_from_the_settings(tmp_path):
 
 
 def test_the_lifespan_opens_the_settings_buses_and_closes_them(tmp_path):
-    app = create_app(Settings(projects_dir=tmp_path, static_dir=tmp_path / "no-ui", buses=("sim",)))
+    app = admin_app(Settings(projects_dir=tmp_path, static_dir=tmp_path / "no-ui", buses=("sim",)), tmp_path / "data")
     connections = app.state.server.connections
     assert connections.list() == []
-    with TestClient(app) as client:
+    with api_client(app) as client:
         assert [bus["id"] for bus in client.get("/api/buses").json()] == ["sim"]
     assert connections.list() == []

@@ -1,4 +1,5 @@
-"""Axis dashboard against the simulated drives: enabling needs explicit clicks and the state follows."""
+"""Axis dashboard against the simulated drives: enabling needs explicit clicks (arm, then each transition) and the
+state follows."""
 
 import re
 import time
@@ -31,6 +32,9 @@ def test_live_values_and_enabling_the_axis_step_by_step(page: Page, demo_server:
     expect(state).to_have_text("Ready to switch on")
     page.get_by_test_id("transition-switch_on").click()
     expect(state).to_have_text("Switched on")
+    expect(page.get_by_test_id("transition-enable_operation")).to_be_disabled()  # motion needs an armed controller
+    page.get_by_test_id("control-arm").click()
+    expect(page.get_by_test_id("controller-holder")).to_have_text("Armed by this page")
     page.get_by_test_id("transition-enable_operation").click()
     expect(state).to_have_text("Operation enabled")
     assert drive_state(demo_server, node) == "OPERATION ENABLED"
@@ -53,6 +57,8 @@ def test_live_values_and_enabling_the_axis_step_by_step(page: Page, demo_server:
     page.get_by_test_id("transition-disable_voltage").click()
     expect(state).to_have_text("Switch on disabled")
     assert drive_state(demo_server, node) == "SWITCH ON DISABLED"
+    page.get_by_test_id("control-release").click()
+    expect(page.get_by_test_id("control-arm")).to_be_visible()
 
 
 def test_closing_the_page_stops_the_axis_it_enabled(browser, demo_server: DemoServer) -> None:
@@ -66,6 +72,8 @@ def test_closing_the_page_stops_the_axis_it_enabled(browser, demo_server: DemoSe
     if state.inner_text() != "Switch on disabled":
         page.get_by_test_id("transition-disable_voltage").click()
     expect(state).to_have_text("Switch on disabled")
+    page.get_by_test_id("control-arm").click()
+    expect(page.get_by_test_id("controller-holder")).to_have_text("Armed by this page")
     for transition, shown in (
         ("shutdown", "Ready to switch on"),
         ("switch_on", "Switched on"),

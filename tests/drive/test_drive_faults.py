@@ -5,6 +5,7 @@ from __future__ import annotations
 import time
 
 import pytest
+from tests.support.motion import controlling
 
 from servostudio.drive.cia402 import State
 from servostudio.drive.control import StateChangeError, fault_report, read_state, reset_faults, set_state
@@ -20,6 +21,7 @@ def bus(socketcand):
     connection = manager.open(socketcand.spec)
     scan(connection, nodes=[1])
     connection.events_seen = events
+    connection.manager = manager
     yield connection
     manager.close_all()
 
@@ -31,7 +33,10 @@ def test_software_limit_fault_is_reported_and_reset(bus):
     drive.write("0x607D,2", 200000)
     drive.write("0x3360", 1)
     try:
-        with pytest.raises(StateChangeError, match=r"node 1: in FAULT.*\(Software position limit\); reset the fault"):
+        with (
+            controlling(bus.manager, bus.id, 1),
+            pytest.raises(StateChangeError, match=r"node 1: in FAULT.*\(Software position limit\); reset the fault"),
+        ):
             set_state(drive, State.OPERATION_ENABLED)
         report = fault_report(drive)
         assert report.state == "FAULT" and report.error_code == 0x8680

@@ -218,3 +218,50 @@ def test_a_batch_write_without_data_is_refused_before_anything_is_sent(engine, s
     with pytest.raises(ValueError, match="at least one byte"):
         engine.download_all(1, [(0x2003, 0, (5).to_bytes(4, "little")), (0x2001, 0, b"")])
     assert slaves[1].sdo[0x2003].raw != 5
+
+
+class _Counter:
+    """Counts the finished transfers of batches (``on_each`` runs on the bus reader thread)."""
+
+    def __init__(self) -> None:
+        self.done = 0
+
+    def __call__(self, position: int, outcome: object) -> None:
+        self.done += 1
+
+
+def test_a_single_read_is_served_ahead_of_the_queued_batches(engine):
+    """Interactive reads go ahead of bulk work: behind five queued 300-read batches (a backup each), a read waits
+    for the transfer on the wire only, not for 1500 reads."""
+    counter = _Counter()
+    batches = [engine.upload_all(1, [(0x2001, 0)] * 300, on_each=counter) for _ in range(5)]
+    before = counter.done
+    assert engine.upload(1, 0x2001, 0).result(5) == b"\x07"
+    assert counter.done - before <= 2  # the transfer on the wire, and at most one that finished meanwhile
+    outcomes = [outcome for batch in batches for outcome in batch.future.result(20)]
+    assert outcomes == [b"\x07"] * 1500  # the batches themselves are unharmed, in order
+
+
+def test_closing_the_bus_fails_the_work_in_flight_at_once(engine):
+    """Nothing answers or times out a transfer once the reader thread stopped: closing must end them itself."""
+    batch = engine.upload_all(1, [(0x2001, 0)] * 1000)
+    single = engine.upload(1, 0x2002, 0)
+    engine.link.close()
+    outcomes = batch.future.result(1)
+    assert isinstance(outcomes[-1], SdoLinkError) and "bus test was closed" in str(outcomes[-1])
+    with pytest.raises(SdoLinkError, match="was closed"):
+        single.result(1)
+    with pytest.raises(SdoLinkError, match=r"not connected \(closed\)"):
+        engine.upload(1, 0x2001, 0).result(1)
+
+
+def test_a_wait_is_bounded_even_when_no_outcome_comes():
+    """`settle` is the safety net of every wait: a future nobody completes ends in the taxonomy's timeout."""
+    from concurrent.futures import Future
+
+    from servostudio.drive.sdo import OutcomeOverdue, settle
+    from servostudio.errors import ErrorKind
+
+    with pytest.raises(OutcomeOverdue) as overdue:
+        settle(Future(), 0.05)
+    assert overdue.value.kind is ErrorKind.TIMEOUT

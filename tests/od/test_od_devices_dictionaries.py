@@ -613,3 +613,25 @@ def test_the_library_matches_a_scanned_identity_to_the_right_dictionary() -> Non
     assert library.match(0x82, 0) == "cd1k"  # a CD1-k aborts the read of 1018h/2: product code 0
     assert library.match(0, 736025) == "encotrive"
     assert library.match(0x82, 736025) is None
+
+
+def _label(name: str) -> str:
+    """The first word of a bit's name: what a panel with one short label per bit shows."""
+    return name.replace("/", " ").replace("(", " ").split()[0]
+
+
+def test_cd1k_io_bits_carry_the_manuals_own_input_and_output_names(cd1k) -> None:
+    inputs = {field.first: field.name for field in cd1k[0x60FD, 0].bits}
+    outputs = {field.first: field.name for field in cd1k[0x60FE, 1].bits}
+    assert [_label(inputs[bit]) for bit in range(16, 22)] == [
+        "INPUT0",
+        "INPUT1",
+        "INHIBIT",
+        "INPUT3",
+        "INPUT4",
+        "INPUT5",
+    ]
+    assert [_label(outputs[bit]) for bit in (0, 16, 17, 18, 19)] == ["Brake", "DO0", "DO1", "DO2", "DO3"]
+    for word in (inputs, outputs):
+        labels = [_label(name) for name in word.values()]
+        assert len(set(labels)) == len(labels), labels

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import pytest
+from tests.support.motion import controlling
 
 from servostudio.services.bus import ConnectionManager
 from servostudio.services.scan import scan
@@ -34,7 +35,8 @@ def test_cd1k_restore_refuses_to_store_while_enabled(commission, tmp_path):
         commission(drive)
         path = tmp_path / "DRIVEPAR.TXT"
         backup_file(drive, path)
-        set_state(drive, State.OPERATION_ENABLED)
+        with controlling(manager, bus.id, 5):
+            set_state(drive, State.OPERATION_ENABLED)
         with pytest.raises(BackupError, match="only with the drive disabled; disable it first — nothing was written"):
             restore_file(drive, path)
         set_state(drive, State.SWITCH_ON_DISABLED)

@@ -1,4 +1,7 @@
-"""A real `servostudio serve` process on a free localhost port, as a user starts it (API and browser tests)."""
+"""A real `servostudio serve` process on a free localhost port, as a user starts it (API and browser tests).
+
+Its data directory is fresh: opted into the password-less single-user mode (`tests.support.access`) unless the
+test passes one it prepared itself (users, tokens, or nothing at all for the first-start setup)."""
 
 from __future__ import annotations
 
@@ -11,6 +14,7 @@ from pathlib import Path
 
 import httpx
 import pytest
+from tests.support.access import passwordless
 
 REPO_ROOT = Path(__file__).resolve().parents[2]
 
@@ -24,9 +28,10 @@ def free_port() -> int:
 class LiveServer:
     """`servostudio serve` in a child process, as a user would start it."""
 
-    def __init__(self, projects_dir: Path, extra_args: list[str] | None = None) -> None:
+    def __init__(self, projects_dir: Path, extra_args: list[str] | None = None, data_dir: Path | None = None) -> None:
         self.port = free_port()
         self.url = f"http://127.0.0.1:{self.port}"
+        self.data_dir = data_dir or passwordless(projects_dir.parent / f"data-{self.port}")
         command = [
             sys.executable,
             "-m",
@@ -36,6 +41,8 @@ class LiveServer:
             str(self.port),
             "--projects",
             str(projects_dir),
+            "--data-dir",
+            str(self.data_dir),
             *(extra_args or []),
         ]
         self.log = projects_dir.parent / f"server-{self.port}.log"

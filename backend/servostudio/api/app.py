@@ -8,17 +8,30 @@ from __future__ import annotations
 
 from collections.abc import AsyncIterator
 from contextlib import asynccontextmanager
-from pathlib import Path
 
 from fastapi import FastAPI
-from fastapi.responses import FileResponse, HTMLResponse
-from fastapi.staticfiles import StaticFiles
 from starlette.middleware import Middleware
 
 from servostudio import __version__
+from servostudio.api.auth import announce_setup
 from servostudio.api.errors import EXCEPTION_HANDLERS, RequestIds, error_responses
-from servostudio.api.routes import backup, buses, dictionaries, drives, events, health, projects, users
+from servostudio.api.limits import BodyLimits
+from servostudio.api.routes import (
+    audit,
+    backup,
+    buses,
+    control,
+    dictionaries,
+    drives,
+    events,
+    health,
+    projects,
+    scope,
+    users,
+)
+from servostudio.api.security import BrowserOrigin, OriginPolicy
 from servostudio.api.state import ServerState
+from servostudio.api.ui import mount_ui
 from servostudio.errors import ErrorKind
 from servostudio.services.settings import Settings
 
@@ -33,45 +46,27 @@ def create_app(settings: Settings | None = None) -> FastAPI:
         description="Communication server of Servo Studio: buses, drives, parameters, projects.",
         lifespan=_lifespan,
         exception_handlers=EXCEPTION_HANDLERS,
-        middleware=[Middleware(RequestIds)],
+        middleware=[
+            Middleware(RequestIds),
+            Middleware(BrowserOrigin, policy=OriginPolicy.of(state.settings)),
+            Middleware(BodyLimits),
+        ],
         responses=error_responses(ErrorKind.INVALID_INPUT, ErrorKind.INTERNAL),
     )
     app.state.server = state
-    for router in (health, users, dictionaries, projects, buses, drives, backup, events):
+    for router in (health, users, dictionaries, projects, buses, drives, control, backup, scope, events, audit):
         app.include_router(router.router, prefix="/api")
-    _mount_ui(app, state.settings.static_dir)
+    mount_ui(app, state.settings.static_dir)
     return app
 
 
 @asynccontextmanager
 async def _lifespan(app: FastAPI) -> AsyncIterator[None]:
-    """Open the buses the server was started with; close every bus at shutdown."""
+    """Open the buses the server was started with (and print the first start's setup link); close every bus at
+    shutdown."""
     state: ServerState = app.state.server
+    announce_setup(state.access, state.settings)
+    state.projects.store.remove_stale_temporaries()  # what saves interrupted by a crash left behind
     state.open_buses()
     yield
     state.close()
-
-
-def _mount_ui(app: FastAPI, static_dir: Path) -> None:
-    """Serve the built browser UI; every non-API path falls back to index.html (client-side routing)."""
-    index = static_dir / "index.html"
-    if not index.is_file():
-
-        @app.get("/", include_in_schema=False)
-        def ui_missing() -> HTMLResponse:
-            return HTMLResponse(
-                "<h1>Servo Studio</h1><p>The browser UI is not built: run <code>make run</code>.</p>",
-                status_code=503,
-            )
-
-        return
-    assets = static_dir / "assets"
-    if assets.is_dir():
-        app.mount("/assets", StaticFiles(directory=assets), name="assets")
-
-    @app.get("/{path:path}", include_in_schema=False)
-    def ui(path: str) -> FileResponse:
-        candidate = (static_dir / path).resolve()
-        if path and candidate.is_file() and candidate.is_relative_to(static_dir.resolve()):
-            return FileResponse(candidate)
-        return FileResponse(index)

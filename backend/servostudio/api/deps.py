@@ -1,40 +1,29 @@
 """Dependencies of the routes, one ``Annotated`` alias each: the caller, the server's state and its parts, and the
 bus and drive a path names.
 
-``current_user`` is the one place a caller's identity comes from; every router and WebSocket depends on it, so
-user levels (the manual's password-protected levels) plug in here later without touching the routes.  The
-server binds to localhost only, so today every caller is the local administrator.
+``current_user`` is the one place a caller's identity comes from (``api.auth``: an API token, a browser session,
+or the password-less local administrator); the level each route declares (``api.security.Requires``) is checked
+against it.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from typing import Annotated
 
 from fastapi import Depends, Header, Query
 from starlette.requests import HTTPConnection
 
+from servostudio.api import auth
 from servostudio.api.state import ServerState
 from servostudio.drive.access import Drive
 from servostudio.od import EdsLibrary
+from servostudio.services.audit import Actor, act_as
 from servostudio.services.bus import BusConnection, ConnectionManager, EventHub, JobRegistry
 from servostudio.services.motion import MotionGuard
 from servostudio.services.projects import ProjectService
 from servostudio.services.projects.live import LiveProjects
-
-
-@dataclass(frozen=True)
-class User:
-    name: str
-    level: str
-
-
-LOCAL_ADMINISTRATOR = User(name="local", level="administrator")
-
-
-def current_user(connection: HTTPConnection) -> User:
-    """The caller (HTTP request or WebSocket)."""
-    return LOCAL_ADMINISTRATOR
+from servostudio.services.scope import ScopeService
+from servostudio.services.users import AccessControl, User
 
 
 def server_state(connection: HTTPConnection) -> ServerState:
@@ -42,8 +31,38 @@ def server_state(connection: HTTPConnection) -> ServerState:
     return state
 
 
-Caller = Annotated[User, Depends(current_user)]
 Server = Annotated[ServerState, Depends(server_state)]
+
+
+def access(state: Server) -> AccessControl:
+    return state.access
+
+
+Access = Annotated[AccessControl, Depends(access)]
+
+
+def current_user(connection: HTTPConnection, control: Access) -> User:
+    """The caller (HTTP request or WebSocket); 401 when it is nobody."""
+    return auth.identify(connection, control)
+
+
+Caller = Annotated[User, Depends(current_user)]
+#: The caller's live motion client (announced by /api/ws/events): motion requests name it (docs/motion-safety.md).
+MotionClient = Annotated[
+    str | None, Header(alias="X-Servo-Client", description="id announced by /api/ws/events; required for motion")
+]
+
+
+async def acting_caller(user: Caller, client: MotionClient = None) -> Actor:
+    """Who acts in this request, for the motion guard and the audit log, set for everything the request does (jobs
+    it starts carry it along).  ``async`` on purpose: it runs in the request's own context, so the value reaches
+    the route; the bus, drive and project dependencies depend on it, so no route reaches a drive without it."""
+    actor = Actor(user.name, str(user.level), client)
+    act_as(actor)
+    return actor
+
+
+Acting = Annotated[Actor, Depends(acting_caller)]
 
 
 def library(state: Server) -> EdsLibrary:
@@ -66,8 +85,13 @@ def events(state: Server) -> EventHub:
     return state.events
 
 
-def projects(state: Server) -> ProjectService:
+def projects(state: Server, actor: Acting) -> ProjectService:
+    """The project store, with the caller acting (its writes are logged under the caller's name)."""
     return state.projects
+
+
+def scope(state: Server) -> ScopeService:
+    return state.scope
 
 
 Library = Annotated[EdsLibrary, Depends(library)]
@@ -76,6 +100,7 @@ Motion = Annotated[MotionGuard, Depends(motion)]
 Jobs = Annotated[JobRegistry, Depends(jobs)]
 Events = Annotated[EventHub, Depends(events)]
 Projects = Annotated[ProjectService, Depends(projects)]
+ScopeCaptures = Annotated[ScopeService, Depends(scope)]
 
 
 def live_projects(service: Projects, manager: Connections) -> LiveProjects:
@@ -83,8 +108,8 @@ def live_projects(service: Projects, manager: Connections) -> LiveProjects:
     return LiveProjects(service, manager)
 
 
-def bus_connection(bus: str, manager: Connections) -> BusConnection:
-    """The open bus the path names."""
+def bus_connection(bus: str, manager: Connections, actor: Acting) -> BusConnection:
+    """The open bus the path names, with the caller acting (the motion guard judges its writes for the caller)."""
     return manager.get(bus)
 
 
@@ -106,7 +131,3 @@ def node_drive(node: int, connection: OpenBus, device: DeviceKey = None) -> Driv
 
 
 NodeDrive = Annotated[Drive, Depends(node_drive)]
-#: The caller's live motion client (announced by /api/ws/events); required for anything that enables the drive.
-MotionClient = Annotated[
-    str | None, Header(alias="X-Servo-Client", description="id announced by /api/ws/events; required to enable")
-]

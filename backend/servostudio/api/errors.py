@@ -2,7 +2,9 @@
 
 - A :class:`ServoStudioError` is answered with the status of its kind (``OUTCOMES``) and the body
   ``{"detail": message, "error": class name, "kind": kind}``.
-- A request that does not fit its schema: 422, ``detail`` is FastAPI's list of problems, kind ``invalid_input``.
+- A request that does not fit its schema: 422, ``detail`` is FastAPI's list of problems, kind ``invalid_input``;
+  one whose body cannot be parsed at all (not UTF-8 JSON, a broken form) likewise, as `MalformedBody`, where
+  FastAPI would answer a bare 400.
 - Any other exception is a bug: logged with its traceback and answered 500 with kind ``internal`` and the request
   id, so a user can quote it.  Never 422: a programming error is not the caller's bad input.
 
@@ -18,16 +20,27 @@ from typing import Any
 
 from fastapi import Request, Response
 from fastapi.encoders import jsonable_encoder
+from fastapi.exception_handlers import http_exception_handler
 from fastapi.exceptions import RequestValidationError
 from fastapi.responses import JSONResponse
 from pydantic import BaseModel, Field
 from starlette.datastructures import MutableHeaders
+from starlette.exceptions import HTTPException
 from starlette.types import ASGIApp, Message, Receive, Scope, Send
 
-from servostudio.errors import OUTCOMES, ErrorKind, ServoStudioError
+from servostudio.errors import OUTCOMES, ErrorKind, InvalidInput, ServoStudioError
 
 REQUEST_ID_HEADER = "X-Request-ID"
 log = logging.getLogger(__name__)
+#: FastAPI's answer to a body it cannot parse (it raises ``HTTPException(400)``); no route raises 400 itself
+_UNPARSABLE_BODY = 400
+
+
+_JSON = {"application/json": {"schema": {"$ref": "#/components/schemas/ErrorBody"}}}
+
+
+class MalformedBody(InvalidInput):
+    """A request body that could not be parsed at all: nothing of the request was done."""
 
 
 class ErrorBody(BaseModel):
@@ -43,11 +56,14 @@ class ErrorBody(BaseModel):
 
 
 def error_responses(*kinds: ErrorKind) -> dict[int | str, dict[str, Any]]:
-    """The OpenAPI ``responses=`` of routes that may fail with these kinds (kinds sharing a status share an entry)."""
+    """The OpenAPI ``responses=`` of routes that may fail with these kinds (kinds sharing a status share an entry).
+
+    The body is declared as JSON explicitly: FastAPI would file it under the route's own media type, which for a
+    text download is ``text/plain``."""
     responses: dict[int | str, dict[str, Any]] = {}
     for kind in kinds:
         outcome = OUTCOMES[kind]
-        entry = responses.setdefault(outcome.http_status, {"model": ErrorBody, "description": ""})
+        entry = responses.setdefault(outcome.http_status, {"model": ErrorBody, "description": "", "content": _JSON})
         entry["description"] = "; ".join(filter(None, (entry["description"], f"`{kind}`: {outcome.meaning}")))
     return responses
 
@@ -61,10 +77,19 @@ async def _malformed(request: Request, error: RequestValidationError) -> JSONRes
     return JSONResponse(body, status_code=OUTCOMES[ErrorKind.INVALID_INPUT].http_status)
 
 
+async def _http_error(request: Request, error: HTTPException) -> Response:
+    """FastAPI's own 400 for an unparsable body becomes the taxonomy's invalid input; other HTTP errors (an unknown
+    path, a method the path does not have) keep FastAPI's answer."""
+    if error.status_code == _UNPARSABLE_BODY:
+        return await _refused(request, MalformedBody(f"the request body could not be parsed ({error.detail})"))
+    return await http_exception_handler(request, error)
+
+
 #: for ``FastAPI(exception_handlers=…)``
 EXCEPTION_HANDLERS: dict[int | type[Exception], Callable[[Request, Any], Coroutine[Any, Any, Response]]] = {
     ServoStudioError: _refused,
     RequestValidationError: _malformed,
+    HTTPException: _http_error,
 }
 
 

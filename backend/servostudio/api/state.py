@@ -3,13 +3,16 @@ through ``api.deps`` and never assembles it."""
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 from servostudio.od import EdsLibrary
+from servostudio.services.audit import AuditLog
 from servostudio.services.bus import ConnectionManager, EventHub, JobRegistry
 from servostudio.services.motion import MotionGuard
 from servostudio.services.projects import ProjectService
+from servostudio.services.scope import ScopeService
 from servostudio.services.settings import Settings
+from servostudio.services.users import AccessControl, UserStore
 
 
 @dataclass(frozen=True)
@@ -17,21 +20,28 @@ class ServerState:
     settings: Settings
     library: EdsLibrary  # built-in dictionaries plus the user's imported ones
     connections: ConnectionManager  # the open buses, their drives and the event hub
-    motion: MotionGuard  # live motion clients and the axes they answer for
+    motion: MotionGuard  # the write gate of every drive: live clients, armed axes, the verdict on motion
+    audit: AuditLog  # who wrote what to drives and projects, every motion start and stop (docs/security.md)
     jobs: JobRegistry  # background backups, restores and commissioning
     projects: ProjectService  # the project store
+    access: AccessControl  # users, sessions, API tokens, the first-start setup (docs/security.md)
+    scope: ScopeService = field(default_factory=ScopeService)  # oscilloscope capture jobs, the latest captures
 
     @classmethod
     def build(cls, settings: Settings) -> ServerState:
         library = EdsLibrary(settings.builtin_eds_dir, settings.user_eds_dir)
-        connections = ConnectionManager(library)
+        audit, events = AuditLog(settings.audit_path), EventHub()
+        motion = MotionGuard(events.publish, audit)
+        connections = ConnectionManager(library, events, motion)
         return cls(
             settings=settings,
             library=library,
             connections=connections,
-            motion=MotionGuard(),
+            motion=motion,
+            audit=audit,
             jobs=JobRegistry(connections.events),
-            projects=ProjectService(settings.projects_dir, library, settings.motors_dir),
+            projects=ProjectService(settings.projects_dir, library, settings.motors_dir, audit),
+            access=AccessControl(UserStore(settings.data_dir), settings.host),
         )
 
     @property

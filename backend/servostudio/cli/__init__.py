@@ -7,29 +7,33 @@ so scripts can chain them.
 from __future__ import annotations
 
 import argparse
-import ipaddress
 import os
 import sys
 from pathlib import Path
 
-from servostudio.cli import drive, eds, project
+from servostudio.cli import audit, drive, eds, project, remote, token, user
+from servostudio.cli import scope as scope_cli
 from servostudio.cli import sim as sim_cli
 from servostudio.cli.output import crashed, refused
-from servostudio.errors import RefusedForSafety, ServoStudioError
+from servostudio.errors import ServoStudioError
 from servostudio.services.settings import DEFAULT_HOST, DEFAULT_PORT, Settings
+from servostudio.services.users import RemoteBindRefused, UserStore, check_bind
 
-
-class RemoteBindRefused(RefusedForSafety):
-    """A non-loopback address without --allow-remote: there is no login yet, so the server stays on this machine."""
+__all__ = ["RemoteBindRefused", "build_parser", "main"]
 
 
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="servostudio", description=__doc__.splitlines()[0])
+    remote.add_options(parser)
     commands = parser.add_subparsers(dest="command", required=True)
     _add_serve(commands)
+    user.register(commands)
+    token.register(commands)
     eds.register(commands)
     project.register(commands)
     drive.register(commands)
+    scope_cli.register(commands)
+    audit.register(commands)
     sim_cli.register(commands)
     return parser
 
@@ -47,6 +51,12 @@ def _add_serve(commands: argparse._SubParsersAction) -> None:
         "$XDG_DATA_HOME/servostudio/eds)",
     )
     serve.add_argument(
+        "--export-dir",
+        type=Path,
+        metavar="DIR",
+        help="directory backup and restore jobs may use besides the project store (default: $SERVOSTUDIO_EXPORT_DIR)",
+    )
+    serve.add_argument(
         "--ui",
         type=Path,
         metavar="DIR",
@@ -56,7 +66,22 @@ def _add_serve(commands: argparse._SubParsersAction) -> None:
     serve.add_argument(
         "--allow-remote",
         action="store_true",
-        help="accept a non-loopback --host (there is no login yet: only inside a container or a trusted network)",
+        help="accept a non-loopback --host (needs users in the data directory: everyone must log in)",
+    )
+    user.data_dir_option(serve)
+    serve.add_argument(
+        "--allowed-host",
+        action="append",
+        default=[],
+        metavar="NAME",
+        help="a Host name browsers may use besides localhost and --host (repeatable; others are refused)",
+    )
+    serve.add_argument(
+        "--allowed-origin",
+        action="append",
+        default=[],
+        metavar="ORIGIN",
+        help="a foreign page origin allowed to call the API, e.g. https://hmi.plant.lan (repeatable)",
     )
     serve.add_argument(
         "--bus",
@@ -68,17 +93,9 @@ def _add_serve(commands: argparse._SubParsersAction) -> None:
     serve.set_defaults(handler=_serve)
 
 
-def check_bind_host(host: str, allow_remote: bool) -> None:
-    """The communication server binds to this machine only, unless explicitly told otherwise."""
-    try:
-        local = host == "localhost" or ipaddress.ip_address(host).is_loopback
-    except ValueError:
-        local = False
-    if not (local or allow_remote):
-        raise RemoteBindRefused(
-            f"--host {host}: the server binds to localhost only (127.0.0.1, ::1); "
-            "pass --allow-remote to accept connections from other machines"
-        )
+#: Seconds a stopping server gives the requests in flight before it closes the buses (which ends every drive wait
+#: and job at once), so a SIGTERM stops it within 5 s whatever runs.
+SHUTDOWN_GRACE = 2
 
 
 def _serve(args: argparse.Namespace) -> int:
@@ -86,16 +103,26 @@ def _serve(args: argparse.Namespace) -> int:
 
     from servostudio.api.app import create_app
 
-    check_bind_host(args.host, args.allow_remote)
     settings = Settings.given(
         projects_dir=args.projects,
         user_eds_dir=args.user_eds,
+        export_dir=args.export_dir,
         static_dir=args.ui,
         buses=tuple(args.bus or ["sim"]),
         host=args.host,
         port=args.port,
+        data_dir=args.data_dir,
+        allowed_hosts=tuple(args.allowed_host),
+        allowed_origins=tuple(args.allowed_origin),
     )
-    uvicorn.run(create_app(settings), host=settings.host, port=settings.port, log_level="info")
+    check_bind(settings.host, args.allow_remote, UserStore(settings.data_dir))
+    uvicorn.run(
+        create_app(settings),
+        host=settings.host,
+        port=settings.port,
+        log_level="info",
+        timeout_graceful_shutdown=SHUTDOWN_GRACE,
+    )
     return 0
 
 

@@ -1,8 +1,8 @@
 """Drive commands: ``servostudio scan|read|write|backup|restore|nmt|fault|state --bus SPEC [--node N] …``.
 
 Each command opens the bus, does its work, prints JSON on stdout and exits with the code of what went wrong
-(the kind of the error, see ``servostudio.cli.output``): 3 refused (nothing written), 4 unknown node/object,
-5 communication.
+(the kind of the error, see ``servostudio.cli.output``): 3 refused (nothing written), 4 unknown node/object or a
+scan that found no node, 5 communication.
 """
 
 from __future__ import annotations
@@ -14,11 +14,13 @@ import threading
 from collections.abc import Callable, Sequence
 from pathlib import Path
 
+from servostudio.cli.audit import audit_log, guarded_connections, local_actor
 from servostudio.cli.output import emit
 from servostudio.drive.access import Drive
 from servostudio.drive.cia402 import State
 from servostudio.drive.control import fault_report, read_state, reset_faults, set_state
 from servostudio.drive.link import LinkDownError
+from servostudio.services.audit import acting_as
 from servostudio.services.backup import (
     BackupError,
     RestoreResult,
@@ -28,8 +30,9 @@ from servostudio.services.backup import (
     restore_file,
     run_per_drive,
 )
-from servostudio.services.bus import BusConnection, ConnectionManager
-from servostudio.services.scan import NoAnswer, identified, scan
+from servostudio.services.bus import BusConnection
+from servostudio.services.motion import Axis, MotionGuard
+from servostudio.services.scan import NothingFound, empty_scan_hint, identified, scan
 from servostudio.services.transfers import FileResult, per_node
 
 CONNECT_WAIT = 3.0
@@ -93,13 +96,16 @@ def register(commands: argparse._SubParsersAction) -> None:
 
 
 def _run(args: argparse.Namespace, handler: Callable[[argparse.Namespace, BusConnection], object]) -> int:
-    """Open the bus, run the command on it, close it; errors go to ``main``, which exits with their kind's code."""
-    manager = ConnectionManager()
+    """Open the bus, run the command on it as the person at the terminal (through the motion guard, recorded in
+    the audit log), close it; errors go to ``main``, which exits with their kind's code."""
+    manager = guarded_connections(audit_log())
+    args.motion = manager.motion
     try:
-        connection = manager.open(args.bus, wait=CONNECT_WAIT)
-        if not connection.link.connected:
-            raise LinkDownError(f"bus {args.bus}: not connected ({connection.link.last_error or 'no answer'})")
-        return emit(handler(args, connection))
+        with acting_as(local_actor()):
+            connection = manager.open(args.bus, wait=CONNECT_WAIT)
+            if not connection.link.connected:
+                raise LinkDownError(f"bus {args.bus}: not connected ({connection.link.last_error or 'no answer'})")
+            return emit(handler(args, connection))
     finally:
         manager.close_all()
 
@@ -118,12 +124,18 @@ def _nodes(args: argparse.Namespace, connection: BusConnection) -> list[Drive]:
         return [_drive(args, connection, node) for node in args.node]
     found = scan(connection)
     if not found:
-        raise NoAnswer(f"no node answers on {connection.spec}")
+        raise NothingFound(empty_scan_hint(connection))
     return [connection.drive(info.node) for info in found if info.device]
 
 
 def _scan(args: argparse.Namespace, connection: BusConnection) -> object:
-    return [info.as_dict() for info in scan(connection)]
+    """The nodes found; finding none is a failure here (exit 4, the reasons on stderr), after printing the empty
+    list for scripts that read stdout."""
+    found = [info.as_dict() for info in scan(connection)]
+    if not found:
+        emit(found)
+        raise NothingFound(empty_scan_hint(connection))
+    return found
 
 
 def _read(args: argparse.Namespace, connection: BusConnection) -> object:
@@ -201,29 +213,33 @@ def _state(args: argparse.Namespace, connection: BusConnection) -> object:
     drive = _drive(args, connection)
     target = State.parse(args.target) if args.target else None
     if target is State.OPERATION_ENABLED:
-        _hold_enabled(drive)
+        _hold_enabled(args.motion, (connection.id, drive.node), drive)
     elif target is not None:
         set_state(drive, target)
     state, statusword = read_state(drive)
     return {"node": drive.node, "state": state.value if state else None, "statusword": statusword}
 
 
-def _hold_enabled(drive: Drive) -> None:
-    """Motion needs a live client: this command is it. The axis stays enabled while the command runs and gets a
-    quick stop when it ends (Ctrl-C, SIGTERM, SIGHUP)."""
+def _hold_enabled(motion: MotionGuard, axis: Axis, drive: Drive) -> None:
+    """Motion needs an armed, live controller: this command is it. It arms the axis, which stays enabled while the
+    command runs; when it ends (Ctrl-C, SIGTERM, SIGHUP) the release quick-stops the axis."""
     stop = threading.Event()
     previous = {
         sig: signal.signal(sig, lambda *_: stop.set()) for sig in (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
     }
     try:
-        set_state(drive, State.OPERATION_ENABLED)
-        print(
-            f"node {drive.node}: operation enabled; holding until Ctrl-C or SIGTERM, then quick stop",
-            file=sys.stderr,
-            flush=True,
-        )
-        stop.wait()
+        with motion.live_client(local_actor()) as actor:
+            motion.arm(actor, axis)
+            try:
+                set_state(drive, State.OPERATION_ENABLED)
+                print(
+                    f"node {drive.node}: operation enabled; holding until Ctrl-C or SIGTERM, then quick stop",
+                    file=sys.stderr,
+                    flush=True,
+                )
+                stop.wait()
+            finally:
+                motion.release(actor, axis, drive)
     finally:
-        set_state(drive, State.QUICK_STOP_ACTIVE)
         for sig, handler in previous.items():
             signal.signal(sig, handler)

@@ -67,6 +67,7 @@ def _entry(var) -> dict:
         "low": var.low,
         "high": var.high,
         "default": var.default_expr,
+        "configured": var.parameter_expr,
         "unit": var.unit,
         "save_type": var.save_type.value,
         "group": var.group,

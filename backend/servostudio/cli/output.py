@@ -1,7 +1,8 @@
 """How every CLI command answers: JSON on stdout, a readable error on stderr, the exit code of the error's kind.
 
 The exit codes come from the one table of ``servostudio.errors`` (3 refused — nothing written, 4 not found, 5 the
-bus or the drive failed); 2 is argparse's own for bad arguments, 70 an unexpected error (a bug).
+bus or the drive failed, 6 not logged in — no or a bad token, 7 the caller's level is too low); 2 is argparse's own
+for bad arguments, 70 an unexpected error (a bug).
 """
 
 from __future__ import annotations

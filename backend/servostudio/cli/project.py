@@ -11,10 +11,11 @@ import argparse
 import functools
 from pathlib import Path
 
+from servostudio.cli.audit import audit_log, guarded_connections, local_actor
 from servostudio.cli.output import emit
 from servostudio.errors import CommunicationError, InvalidInput, NotFound
 from servostudio.od import EdsLibrary
-from servostudio.services.bus import ConnectionManager
+from servostudio.services.audit import acting_as
 from servostudio.services.projects import Axis, Bus, DriveMismatch, ProjectService
 from servostudio.services.projects.fsutil import atomic_write
 from servostudio.services.projects.jsonview import (
@@ -183,6 +184,11 @@ def register(commands: argparse._SubParsersAction) -> None:
     dcf.add_argument("name")
     dcf.add_argument("axis")
     dcf.add_argument("output", type=Path)
+    dcf_import = action("dcf-import", _dcf_import, "set an axis's offline values to what a DCF configures")
+    dcf_import.add_argument("name")
+    dcf_import.add_argument("axis")
+    dcf_import.add_argument("dcf", type=Path)
+    revision(dcf_import)
 
     action("motor-list", _motor_list, "motors of the catalog")
     motor_add = action("motor-add", _motor_add, "add a motor file to the user catalog")
@@ -216,10 +222,12 @@ def _run(handler, args: argparse.Namespace) -> int:
     """Run an action on the store; errors go to ``main``, which exits with their kind's code."""
     settings = Settings.given(projects_dir=args.projects, user_eds_dir=args.user_eds_dir)
     library = _library(settings.builtin_eds_dir, settings.user_eds_dir)
-    service = ProjectService(settings.projects_dir, library, settings.motors_dir)
-    args.connections = ConnectionManager(library)  # live actions open buses in it; none is opened otherwise
+    audit = audit_log(settings)
+    service = ProjectService(settings.projects_dir, library, settings.motors_dir, audit)
+    args.connections = guarded_connections(audit, library=library)  # live actions open buses in it
     try:
-        return emit(handler(service, args))
+        with acting_as(local_actor()):
+            return emit(handler(service, args))
     finally:
         args.connections.close_all()
 
@@ -393,6 +401,12 @@ def _dcf(service: ProjectService, args: argparse.Namespace) -> dict:
     text = service.dcf(args.name, args.axis)
     atomic_write(args.output, text.encode("latin-1"))
     return {"dcf": str(args.output)}
+
+
+def _dcf_import(service: ProjectService, args: argparse.Namespace) -> dict:
+    imported = service.import_dcf(args.name, args.axis, args.dcf, args.revision)
+    rows = [parameter_view(row) for row in imported.change.rows]
+    return {"parameters": rows, "skipped": imported.skipped, "revision": imported.change.revision}
 
 
 def _motor_list(service: ProjectService, args: argparse.Namespace) -> list[dict]:

@@ -12,7 +12,9 @@ many reads can be queued at once and awaited from asyncio with ``asyncio.wrap_fu
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
-from concurrent.futures import Future
+from concurrent.futures import CancelledError, Future
+from dataclasses import dataclass
+from typing import Protocol
 
 from servostudio.drive.object_values import ObjectValue, Raw, decode_raw, parse_input
 from servostudio.drive.profiles import DeviceProfile, profile_for
@@ -33,16 +35,63 @@ class UnknownObjectError(NotFound, DriveAccessError):
     """The object is not in the drive's dictionary (or no dictionary is known for the drive)."""
 
 
+@dataclass(frozen=True)
+class PlannedWrite:
+    """One write as the drive will receive it: the raw value the dictionary made of the caller's input (type and
+    range checked), so whoever judges it sees what the drive will see, not how the caller spelled it."""
+
+    index: int
+    sub: int
+    raw: Raw
+    variable: Variable | None = None  # None: bytes to an object the dictionary may not know (a procedure signature)
+
+    @property
+    def key(self) -> tuple[int, int]:
+        return (self.index, self.sub)
+
+
+#: What a gate hears once the writes it let through are done: per write, in order, the value written or the error.
+WriteOutcomes = Callable[[Sequence[object]], None]
+
+
+class WriteGate(Protocol):
+    """Every write of a :class:`Drive` passes its gate after the dictionary converted it and before a frame is sent:
+    the gate refuses by raising, and hears the outcomes.  The server's gate is the motion guard with the audit log
+    (``services.motion``); the drive layer alone lets everything through."""
+
+    def admit(self, drive: Drive, writes: Sequence[PlannedWrite]) -> WriteOutcomes: ...
+
+
+class OpenGate:
+    """Lets every write through and records nothing: drive access on its own, without the server's services."""
+
+    def admit(self, drive: Drive, writes: Sequence[PlannedWrite]) -> WriteOutcomes:
+        return _ignore_outcomes
+
+
+def _ignore_outcomes(outcomes: Sequence[object]) -> None:
+    """An open gate records nothing."""
+
+
+OPEN_GATE = OpenGate()
+
+
 class Drive:
     """One node on one bus, with its dictionary and device profile."""
 
     def __init__(
-        self, engine: SdoEngine, node: int, dictionary: ObjectDictionary | None, profile: DeviceProfile | None = None
+        self,
+        engine: SdoEngine,
+        node: int,
+        dictionary: ObjectDictionary | None,
+        profile: DeviceProfile | None = None,
+        gate: WriteGate = OPEN_GATE,
     ) -> None:
         self.engine = engine
         self.node = node
         self.dictionary = dictionary
         self.profile = profile or profile_for(dictionary.device if dictionary else None)
+        self.gate = gate
 
     def __repr__(self) -> str:
         return f"Drive(node={self.node}, device={self.profile.device!r})"
@@ -130,9 +179,11 @@ class Drive:
         timeout: float | None = None,
         bulk: bool = False,
     ) -> Future:
-        """Check, then queue a write; the future gives the ObjectValue written (``bulk`` as for `submit_read`)."""
+        """Check, pass the gate, then queue a write; the future gives the ObjectValue written (``bulk`` as for
+        `submit_read`)."""
         variable, raw, data = self.prepare_write(key, value, physical)
-        return self.engine.download(
+        heard = self.gate.admit(self, [PlannedWrite(variable.index, variable.subindex, raw, variable)])
+        future = self.engine.download(
             self.node,
             variable.index,
             variable.subindex,
@@ -141,21 +192,27 @@ class Drive:
             convert=lambda _: ObjectValue(self.node, variable, raw),
             bulk=bulk,
         )
+        future.add_done_callback(lambda done: heard([_outcome(done)]))
+        return future
 
     def submit_write_all(
         self,
         writes: Sequence[tuple[Variable, object]],
         on_each: Callable[[int, ObjectValue | Exception], None] | None = None,
     ) -> TransferBatch[ObjectValue]:
-        """Check every write, then queue them all (nothing is sent if one fails its check); the batch's future
-        gives, in order, the ObjectValue written or the exception that ended each write (see `TransferBatch`)."""
+        """Check every write and pass the gate with all of them, then queue them all (nothing is sent if one fails
+        its check or the gate refuses); the batch's future gives, in order, the ObjectValue written or the exception
+        that ended each write (see `TransferBatch`)."""
         prepared = [self.prepare_write(variable, value) for variable, value in writes]
-        return self.engine.download_all(
+        heard = self.gate.admit(self, [PlannedWrite(var.index, var.subindex, raw, var) for var, raw, _ in prepared])
+        batch = self.engine.download_all(
             self.node,
             [(variable.index, variable.subindex, data) for variable, _, data in prepared],
             convert=lambda position, _: ObjectValue(self.node, prepared[position][0], prepared[position][1]),
             on_each=on_each,
         )
+        batch.future.add_done_callback(lambda done: heard(_batch_outcomes(done, len(prepared))))
+        return batch
 
     def write(
         self, key: str | tuple[int, int] | Variable, value: object, physical: bool = False, timeout: float | None = None
@@ -163,10 +220,27 @@ class Drive:
         return settle(self.submit_write(key, value, physical, timeout), DEFAULT_WAIT + (timeout or 0))
 
     def write_raw_bytes(self, index: int, sub: int, data: bytes, timeout: float | None = None) -> None:
-        """Write bytes to an object the dictionary may not know (procedure signatures on unknown devices)."""
-        settle(self.engine.download(self.node, index, sub, data, timeout), DEFAULT_WAIT + (timeout or 0))
+        """Write bytes to an object the dictionary may not know (procedure signatures on unknown devices); the gate
+        sees them as the integer the drive reads (little-endian), as a typed write of the object would give."""
+        raw: Raw = int.from_bytes(data, "little") if len(data) <= 4 else data
+        heard = self.gate.admit(self, [PlannedWrite(index, sub, raw)])
+        future = self.engine.download(self.node, index, sub, data, timeout)
+        future.add_done_callback(lambda done: heard([_outcome(done)]))
+        settle(future, DEFAULT_WAIT + (timeout or 0))
 
     def start_procedure(self, procedure: str, timeout: float = 10.0) -> None:
         """Write a procedure's signature (decisions.md §4), e.g. "save" → 0x1010,1 = 'save'."""
         (index, sub), value = self.profile.signature(procedure)
         self.write_raw_bytes(index, sub, value.to_bytes(4, "little"), timeout)
+
+
+def _outcome(done: Future) -> object:
+    """A finished transfer as the gate hears it: the value, or the exception that ended it."""
+    error = done.exception() if not done.cancelled() else CancelledError()
+    return error if error is not None else done.result()
+
+
+def _batch_outcomes(done: Future, count: int) -> Sequence[object]:
+    """A finished batch as the gate hears it: its outcomes, or the one error that ended them all."""
+    outcome = _outcome(done)
+    return outcome if isinstance(outcome, list) else [outcome] * count

@@ -114,3 +114,53 @@ def next_command(current: State, target: State) -> Command | None:
     if _ORDER.index(target) > _ORDER.index(current):
         return _UP[current]
     return _DOWN[current]
+
+
+FAULT_RESET_BIT = 0x80
+
+
+def decode_command(controlword: int) -> Command:
+    """The device-control command a drive reads in bits 3–0 (CiA 402 table, XtrapulsPac manual §3.2.1.2), checked
+    in the standard's order: a cleared bit 1 is Disable voltage whatever the others say, then bit 2, then bit 0.
+    Bit 7 (fault reset) is left to :func:`transition`: drives apply the bits 3–0 command with it all the same."""
+    if not controlword & 0x02:
+        return Command.DISABLE_VOLTAGE
+    if not controlword & 0x04:
+        return Command.QUICK_STOP
+    if not controlword & 0x01:
+        return Command.SHUTDOWN
+    return Command.ENABLE_OPERATION if controlword & 0x08 else Command.SWITCH_ON
+
+
+#: (state, command) → the state the drive goes to; a pair not listed leaves the state as it is.  Switch on +
+#: Enable operation from READY TO SWITCH ON goes through to OPERATION ENABLED (transitions 3 + 4), and Enable
+#: operation leads back from QUICK STOP ACTIVE (transition 16, with quick-stop option codes 5–8).
+_TRANSITIONS: dict[tuple[State, Command], State] = {
+    (State.SWITCH_ON_DISABLED, Command.SHUTDOWN): State.READY_TO_SWITCH_ON,
+    (State.READY_TO_SWITCH_ON, Command.DISABLE_VOLTAGE): State.SWITCH_ON_DISABLED,
+    (State.READY_TO_SWITCH_ON, Command.QUICK_STOP): State.SWITCH_ON_DISABLED,
+    (State.READY_TO_SWITCH_ON, Command.SWITCH_ON): State.SWITCHED_ON,
+    (State.READY_TO_SWITCH_ON, Command.ENABLE_OPERATION): State.OPERATION_ENABLED,
+    (State.SWITCHED_ON, Command.DISABLE_VOLTAGE): State.SWITCH_ON_DISABLED,
+    (State.SWITCHED_ON, Command.QUICK_STOP): State.SWITCH_ON_DISABLED,
+    (State.SWITCHED_ON, Command.SHUTDOWN): State.READY_TO_SWITCH_ON,
+    (State.SWITCHED_ON, Command.ENABLE_OPERATION): State.OPERATION_ENABLED,
+    (State.OPERATION_ENABLED, Command.DISABLE_VOLTAGE): State.SWITCH_ON_DISABLED,
+    (State.OPERATION_ENABLED, Command.QUICK_STOP): State.QUICK_STOP_ACTIVE,
+    (State.OPERATION_ENABLED, Command.SHUTDOWN): State.READY_TO_SWITCH_ON,
+    (State.OPERATION_ENABLED, Command.SWITCH_ON): State.SWITCHED_ON,
+    (State.QUICK_STOP_ACTIVE, Command.DISABLE_VOLTAGE): State.SWITCH_ON_DISABLED,
+    (State.QUICK_STOP_ACTIVE, Command.ENABLE_OPERATION): State.OPERATION_ENABLED,
+}
+
+
+def transition(state: State, controlword: int) -> State:
+    """The state a drive in ``state`` goes to when it receives ``controlword``.
+
+    The worst case where drives differ, because the motion guard decides on it: bit 7 in FAULT is taken as the
+    reset edge (the previous control word is not known), and the bits 3–0 command then applies from SWITCH ON
+    DISABLED as the drives do; Enable operation from QUICK STOP ACTIVE is taken as leading back to OPERATION
+    ENABLED whatever the quick-stop option code."""
+    if state is State.FAULT and controlword & FAULT_RESET_BIT:
+        state = State.SWITCH_ON_DISABLED
+    return _TRANSITIONS.get((state, decode_command(controlword)), state)

@@ -8,6 +8,7 @@ from dataclasses import dataclass, field
 from servostudio.drive.access import Drive
 from servostudio.drive.cia402 import Command, State, apply_command, decode_state, next_command
 from servostudio.drive.faults import FaultInfo, cia402_error_text, faults_from_words
+from servostudio.drive.prerequisites import Unmet, check_move, procedure_causes
 from servostudio.errors import Conflict
 
 STEP_TIMEOUT = 1.0
@@ -27,8 +28,11 @@ def set_state(drive: Drive, target: State, step_timeout: float = STEP_TIMEOUT) -
     """Walk the CiA 402 state machine to ``target`` one command at a time, checking each step.
 
     A drive in FAULT is not reset on the way: resetting a fault is the user's decision (``reset_faults``), so the
-    error names the active faults instead.
+    error names the active faults instead.  An axis that could not move once enabled (a limit of its mode is 0) is
+    not enabled: the error names the objects that stop it.
     """
+    if target is State.OPERATION_ENABLED:
+        check_move(drive)
     for _ in range(8):
         state, statusword = read_state(drive)
         if state is None:
@@ -84,6 +88,8 @@ class FaultReport:
     error_text: str
     faults: list[FaultInfo] = field(default_factory=list)
     warnings: list[FaultInfo] = field(default_factory=list)
+    #: what the tool sees behind the faults: objects a failed procedure needed, at 0 or out of range
+    causes: list[Unmet] = field(default_factory=list)
 
     def as_dict(self) -> dict[str, object]:
         return {
@@ -95,22 +101,37 @@ class FaultReport:
             "error_text": self.error_text,
             "faults": [item.as_dict() for item in self.faults],
             "warnings": [item.as_dict() for item in self.warnings],
+            "causes": [item.as_dict() for item in self.causes],
         }
 
 
 def fault_report(drive: Drive) -> FaultReport:
-    """Status word, 0x603F and the device's error/warning words decoded with the manual's texts."""
+    """Status word, 0x603F and the device's error/warning words decoded with the manual's texts, and for a failed
+    procedure the inputs it needed that the tool sees at 0 or out of range (the drive itself only says "failed")."""
     profile = drive.profile
     state, statusword = read_state(drive)
     error_code = int(drive.read("error_code").raw) if profile.has("error_code") else 0
-    error_text = cia402_error_text(error_code)
-    if error_code in profile.emcy_codes:
-        error_text = profile.emcy_codes[error_code].name
+    known = profile.emcy_codes.get(error_code)
+    faults = _word_faults(drive) or [fault for fault in [profile.code_fault(error_code)] if fault]
+    failed = profile.procedure_fault is not None and any(fault.code == profile.procedure_fault for fault in faults)
+    return FaultReport(
+        drive.node,
+        state.value if state else None,
+        statusword,
+        error_code,
+        known.name if known else cia402_error_text(error_code),
+        faults,
+        _warnings(drive),
+        procedure_causes(drive) if failed else [],
+    )
+
+
+def _word_faults(drive: Drive) -> list[FaultInfo]:
+    profile = drive.profile
     words = [(int(drive.read(name).raw), first) for name, first in profile.error_words]
-    faults = faults_from_words(dict(profile.errors), words)
-    if not faults and error_code in profile.emcy_codes:
-        faults = [profile.emcy_codes[error_code]]
-    warnings = []
-    if profile.warning_word:
-        warnings = faults_from_words(dict(profile.warnings), [(int(drive.read(profile.warning_word).raw), 1)])
-    return FaultReport(drive.node, state.value if state else None, statusword, error_code, error_text, faults, warnings)
+    return faults_from_words(profile.errors, words, profile.coded_error_bits)
+
+
+def _warnings(drive: Drive) -> list[FaultInfo]:
+    name = drive.profile.warning_word
+    return faults_from_words(drive.profile.warnings, [(int(drive.read(name).raw), 1)]) if name else []

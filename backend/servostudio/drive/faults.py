@@ -7,6 +7,7 @@ error-code classes used when a device table does not know a code.
 from __future__ import annotations
 
 import struct
+from collections.abc import Mapping
 from dataclasses import asdict, dataclass
 
 
@@ -92,14 +93,40 @@ def cia402_error_text(code: int) -> str:
     return "unknown error class"
 
 
-def faults_from_words(table: dict[int, FaultInfo], words: list[tuple[int, int]]) -> list[FaultInfo]:
-    """Active faults of error words given as ``(value, first_code)``: bit b of a word is code first_code + b."""
+@dataclass(frozen=True)
+class CodedBits:
+    """Bits ``first``..``last`` of an error word that hold one code rather than one fault per bit (the CD1-k's power
+    fault in bits 16-18 of 0x3020): the fault of each value, 0 meaning none."""
+
+    first: int
+    last: int
+    faults: Mapping[int, FaultInfo]
+
+    @property
+    def mask(self) -> int:
+        return ((1 << (self.last - self.first + 1)) - 1) << self.first
+
+    def decode(self, word: int) -> list[FaultInfo]:
+        value = (word & self.mask) >> self.first
+        if not value:
+            return []
+        unknown = FaultInfo(self.first + 1, 0, f"coded fault {value:#b} in bits {self.first}-{self.last}", "")
+        return [self.faults.get(value, unknown)]
+
+
+def faults_from_words(
+    table: Mapping[int, FaultInfo], words: list[tuple[int, int]], coded: tuple[CodedBits, ...] = ()
+) -> list[FaultInfo]:
+    """Active faults of error words given as ``(value, first_code)``: bit b of a word is code first_code + b, except
+    the ``coded`` bit fields, which hold one code each."""
+    coded_mask = sum(field.mask for field in coded)
     active = []
     for value, first_code in words:
         for bit in range(32):
-            if value >> bit & 1:
+            if value >> bit & 1 and not coded_mask >> bit & 1:
                 code = first_code + bit
                 active.append(table.get(code, FaultInfo(code, 0, f"error code {code} (not in the manual)", "")))
+        active.extend(fault for field in coded for fault in field.decode(value))
     return active
 
 

@@ -34,9 +34,10 @@ def decode_emergency(node: int, data: bytes, profile: DeviceProfile | None) -> E
         if profile.emcy_layout is EmcyLayout.CODE_BYTE and manufacturer[0] in profile.errors:
             faults = [profile.errors[manufacturer[0]]]
         elif profile.emcy_layout is EmcyLayout.BITFIELD:
-            faults = faults_from_words(dict(profile.errors), [(int.from_bytes(manufacturer[:4], "little"), 1)])
-        elif code in profile.emcy_codes:
-            faults = [profile.emcy_codes[code]]
+            word = int.from_bytes(manufacturer[:4], "little")
+            faults = faults_from_words(profile.errors, [(word, 1)], profile.coded_error_bits)
+        else:
+            faults = [fault for fault in [profile.code_fault(code)] if fault]
     return Emergency(node, code, register, manufacturer, tuple(faults))
 
 

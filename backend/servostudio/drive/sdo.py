@@ -2,7 +2,7 @@
 
 Every transfer is a small state machine driven by the frames the bus link delivers; nothing blocks while a drive
 thinks.  A caller gets a ``concurrent.futures.Future`` (``asyncio.wrap_future`` makes it awaitable), so a thread can
-wait on it and the event loop never does.  Each node has a FIFO: the next request to a node leaves the moment the
+wait on it and the event loop never does.  Each node has a queue: the next request to a node leaves the moment the
 previous response arrives, from the reader thread itself, so a backup of many drives keeps every drive busy and
 the bus full without one thread per drive.  Futures complete after the reader's batch of frames was handled and
 the follow-up requests left (``BusLink.after_dispatch``).
@@ -15,6 +15,10 @@ sequence transfers of a backup — waits in the bulk lane; a single read or writ
 the terminal, the status-word watch) goes to the interactive lane, which the node serves first.  A batch thus
 yields to interactive requests between its transfers: a read during ten backups waits for at most the one transfer
 on the wire, not for thousands queued before it.
+
+A node's boot-up message (it was reset or powered up again) ends its transfers in progress and queued with
+`SdoNodeRestarted`: what they asked was asked of a drive state that no longer exists, and a backup across a reset
+would mix values from before and after it.
 
 Every transfer ends by itself — answer, abort, timeout, link lost, bus closed — so a future never stays pending;
 waits on futures are still bounded (`settle`, `TransferBatch.outcomes`), as a safety net against a stuck reader.
@@ -39,6 +43,7 @@ from servostudio.errors import CommunicationError, Conflict, Timeout, Unavailabl
 
 SDO_REQUEST = 0x600
 SDO_RESPONSE = 0x580
+BOOT_UP = 0x700  # + node: the error-control message whose single byte 0 says the node (re)started
 DEFAULT_TIMEOUT = 0.5
 #: Safety net of every wait on a transfer: the engine ends each transfer itself, but a transfer may wait behind
 #: many queued ones of its node, and a stuck reader thread must not hang a request or a job for ever.
@@ -81,6 +86,10 @@ class SdoLinkError(Unavailable, SdoError):
     """The bus went down (or was closed) before or during the transfer."""
 
 
+class SdoNodeRestarted(SdoError):
+    """The node sent its boot-up message while the transfer was in progress or queued: it was reset or power-cycled."""
+
+
 class OutcomeOverdue(Timeout):
     """A transfer's outcome did not arrive within the safety bound of the wait (the bus reader is stuck)."""
 
@@ -90,9 +99,7 @@ def settle(future: Future[R], seconds: float = SAFETY_WAIT) -> R:
     try:
         return future.result(seconds)
     except TimeoutError:
-        raise OutcomeOverdue(
-            f"no outcome of the transfer within {seconds:.0f} s; the bus reader may be stuck"
-        ) from None
+        raise OutcomeOverdue(f"no outcome of the transfer within {seconds:.0f} s; the bus reader is stuck") from None
 
 
 class _FutureCompletion:
@@ -395,6 +402,7 @@ class SdoEngine:
             if node not in self._queues:
                 self._queues[node] = _NodeQueue()
                 self.link.subscribe(SDO_RESPONSE + node, self._on_response)
+                self.link.subscribe(BOOT_UP + node, self._on_error_control)
             self._queues[node].add(transfers, bulk)
             if node not in self._active:
                 self._start_next(node)
@@ -446,6 +454,19 @@ class SdoEngine:
                 follow_up = None
             if follow_up is None or not self._send(transfer, follow_up):
                 self._start_next(node)
+
+    def _on_error_control(self, cob_id: int, data: bytes, timestamp: float) -> None:
+        """A boot-up ends the node's transfers (see the module); heartbeats carry another state byte."""
+        if data != b"\x00":
+            return
+        node = cob_id - BOOT_UP
+        with self._lock:
+            void = [self._active.pop(node)] if node in self._active else []
+            void += self._queues[node].drain()
+            for transfer in void:
+                reason = "the node restarted (boot-up) during the transfer"
+                self._finished.append((transfer, SdoNodeRestarted(node, transfer.index, transfer.sub, reason)))
+        self._hand_over()
 
     def _advance(self, transfer: _Transfer, data: bytes) -> bytes | None:
         """Process one response; return the next request, or None when the transfer is finished."""

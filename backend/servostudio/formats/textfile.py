@@ -20,13 +20,19 @@ def split_lines(text: str) -> list[str]:
 
 
 def write_text_atomic(path: str | os.PathLike[str], text: str) -> None:
-    """Write ``text`` to a temporary file next to ``path``, flush it to disk, then rename it over ``path``.
+    """Write ``text`` (Latin-1) atomically: see `write_bytes_atomic`."""
+    write_bytes_atomic(path, text.encode(FILE_ENCODING))
 
-    ``os.replace`` within one directory is atomic, so ``path`` holds either the old or the new content,
-    never a mix, even if the process dies mid-write.
+
+def write_bytes_atomic(path: str | os.PathLike[str], data: bytes) -> None:
+    """Write ``data`` to a temporary file next to ``path`` (``.NAME.*.tmp``), flush it to disk, then rename it over
+    ``path`` and flush the directory.
+
+    ``os.replace`` within one directory is atomic, so ``path`` holds either the old or the new content, never a
+    mix, even if the process dies mid-write; what such a death leaves is only the temporary file, which the project
+    store removes at the next start.
     """
     target = Path(path)
-    data = text.encode(FILE_ENCODING)
     descriptor, temp_name = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=target.parent)
     try:
         with os.fdopen(descriptor, "wb") as handle:
@@ -38,6 +44,16 @@ def write_text_atomic(path: str | os.PathLike[str], text: str) -> None:
     except BaseException:
         Path(temp_name).unlink(missing_ok=True)
         raise
+    _sync_directory(target.parent)
+
+
+def _sync_directory(directory: Path) -> None:
+    """Make the rename itself durable (a power loss after it must not bring the old file back)."""
+    descriptor = os.open(directory, os.O_RDONLY)
+    try:
+        os.fsync(descriptor)
+    finally:
+        os.close(descriptor)
 
 
 def _mode_for(target: Path) -> int:

@@ -12,7 +12,7 @@ from pathlib import Path
 
 from servostudio.od.datatypes import DataType
 from servostudio.od.eds_values import ValueSyntaxError, parse_integer, parse_number, parse_value
-from servostudio.od.ini import IniFile, IniSection, read_ini
+from servostudio.od.ini import IniEntry, IniFile, IniSection, read_ini
 from servostudio.od.model import (
     Access,
     DictionaryError,
@@ -53,6 +53,8 @@ _OBJECT_KEYS = frozenset(
 )
 _OBJECT_TYPES = {0x2: ObjectKind.VAR, 0x7: ObjectKind.VAR, 0x8: ObjectKind.ARRAY, 0x9: ObjectKind.RECORD}
 NODE_IDS = range(1, 128)
+#: a value read from an EDS: (value without its ``$NODEID`` term, uses ``$NODEID``, the text as written)
+_EdsValue = tuple[int | float | str | bytes | None, bool, str | None]
 
 
 @dataclass(frozen=True)
@@ -73,9 +75,8 @@ def load_dictionary(eds_path: Path, props_path: Path | None = None) -> ObjectDic
         candidate = eds_path.with_suffix(".props")
         props_path = candidate if candidate.exists() else None
     reader = _EdsReader(read_ini(eds_path))
-    info = reader.device_info()
     objects = reader.objects()
-    reader.check_identity(info, objects)
+    info = reader.device_info(objects[0x1018])
     if props_path is not None:
         objects = apply_props(read_ini(Path(props_path)), objects)
     return ObjectDictionary(
@@ -99,29 +100,30 @@ class _EdsReader:
 
     # --- [DeviceInfo] -------------------------------------------------------------------------------------------
 
-    def device_info(self) -> DeviceInfo:
+    def device_info(self, identity: DictObject) -> DeviceInfo:
         section = self.ini.section("DeviceInfo")
         if section is None:
             raise self.error("DeviceInfo", 1, "section [DeviceInfo] is missing")
-        if not section.get("VendorNumber"):
-            raise self.error(section, section.line, "VendorNumber is missing")
         return DeviceInfo(
             product_name=section.get("ProductName") or self.ini.path.stem,
-            vendor_id=self._integer(section, "VendorNumber"),
-            product_code=self._integer(section, "ProductNumber", 0),
-            revision=self._integer(section, "RevisionNumber", 0),
+            vendor_id=self._identity_number(section, "VendorNumber", identity, 1),
+            product_code=self._identity_number(section, "ProductNumber", identity, 2),
+            revision=self._identity_number(section, "RevisionNumber", identity, 3),
         )
 
-    def check_identity(self, info: DeviceInfo, objects: dict[int, DictObject]) -> None:
-        """The identity object's defaults must agree with [DeviceInfo] (dcfchk rejects a mismatch too)."""
-        identity = objects[0x1018].subs
-        for sub, key, expected in ((1, "VendorNumber", info.vendor_id), (2, "ProductNumber", info.product_code)):
-            var = identity.get(sub)
-            if var is not None and isinstance(var.default, int) and var.default not in (0, expected):
-                section = self.ini.known_section("DeviceInfo")
-                raise self.error(
-                    section, section.line_of(key), f"{key} {expected:#x} differs from 0x1018,{sub} ({var.default:#x})"
-                )
+    def _identity_number(self, section: IniSection, key: str, identity: DictObject, sub: int) -> int:
+        """A [DeviceInfo] number, else the 0x1018 default, else 0, as dcfchk reads it.
+
+        CANopenNode writes ``VendorNumber=`` with no value: an empty key says as little as an absent one.  A given
+        number must agree with a non-zero 0x1018 default; an absent one is not compared (dcfchk does the same)."""
+        default = _integer_default(identity.subs.get(sub))
+        if not section.get(key):
+            return default
+        value = self._integer(section, key)
+        if default not in (0, value):
+            reason = f"{key} {value:#x} differs from 0x1018,{sub} ({default:#x})"
+            raise self.error(section, section.line_of(key), reason)
+        return value
 
     # --- object lists -------------------------------------------------------------------------------------------
 
@@ -152,9 +154,6 @@ class _EdsReader:
         return listed
 
     def _read_list(self, section: IniSection) -> list[tuple[int, int]]:
-        count_text = section.get("SupportedObjects")
-        if count_text is None:
-            raise self.error(section, section.line, "SupportedObjects is missing")
         count = self._integer(section, "SupportedObjects")
         entries = []
         for listed in section:
@@ -164,8 +163,10 @@ class _EdsReader:
                 raise self.error(section, listed.line, f"unexpected entry {listed.key!r} (SupportedObjects={count})")
         for number in range(1, count + 1):
             entry = section.entry(str(number))
-            if entry is None:
-                raise self.error(section, section.line_of("SupportedObjects"), f"entry {number} is missing")
+            if entry is None or not entry.value:
+                state = "missing" if entry is None else "empty"
+                line = section.line_of("SupportedObjects") if entry is None else entry.line
+                raise self.error(section, line, f"entry {number} is {state}")
             try:
                 index = parse_integer(entry.value)
             except ValueSyntaxError as exc:
@@ -269,25 +270,48 @@ class _EdsReader:
             )
         }
         template = self._variable(section, index, 1, name)
+        configured = self._compact_values(index, count, template)
         for sub in range(1, count + 1):
-            subs[sub] = replace(template, subindex=sub, name=names.get(sub, f"{name}{sub}"))
+            value, uses_node_id, text = configured.get(sub, (None, False, None))
+            subs[sub] = replace(
+                template,
+                subindex=sub,
+                name=names.get(sub, f"{name}{sub}"),
+                parameter_value=value,
+                parameter_expr=text,
+                parameter_uses_node_id=uses_node_id,
+            )
         return subs
 
     def _compact_names(self, index: int, count: int) -> dict[int, str]:
         section = self.ini.section(f"{index:04X}Name")
+        return {} if section is None else {sub: entry.value for sub, entry in self._compact_entries(section, count)}
+
+    def _compact_values(self, index: int, count: int, template: Variable) -> dict[int, _EdsValue]:
+        """A DCF's ``[xxxxValue]`` section: the configured value of each compact sub-index, checked like any
+        ParameterValue (type, limits, ``$NODEID``)."""
+        section = self.ini.section(f"{index:04X}Value")
         if section is None:
             return {}
-        names = {}
+        low, high = template.low, template.high
+        entries = self._compact_entries(section, count)
+        return {sub: self._default(section, template.data_type, low, high, entry.key) for sub, entry in entries}
+
+    def _compact_entries(self, section: IniSection, count: int) -> list[tuple[int, IniEntry]]:
+        """The numbered entries of a ``[xxxxName]`` / ``[xxxxValue]`` section, which NrOfEntries must count."""
+        entries = []
         for entry in section:
             if entry.key.lower() == "nrofentries":
                 continue
             if not entry.key.isdigit() or not 1 <= int(entry.key) <= count:
                 raise self.error(section, entry.line, f"sub-index {entry.key!r} is not 1..{count}")
-            names[int(entry.key)] = entry.value
+            entries.append((int(entry.key), entry))
         declared = self._integer(section, "NrOfEntries")
-        if declared != len(names):
-            raise self.error(section, section.line_of("NrOfEntries"), f"NrOfEntries={declared} but {len(names)} names")
-        return names
+        if declared != len(entries):
+            raise self.error(
+                section, section.line_of("NrOfEntries"), f"NrOfEntries={declared} but {len(entries)} entries"
+            )
+        return entries
 
     # --- one entry ----------------------------------------------------------------------------------------------
 
@@ -305,7 +329,9 @@ class _EdsReader:
         if low is not None and high is not None and low > high:
             raise self.error(section, section.line_of("LowLimit"), f"LowLimit {low} is above HighLimit {high}")
         default, uses_node_id, expr = self._default(section, data_type, low, high, "DefaultValue")
-        self._default(section, data_type, low, high, "ParameterValue")  # a DCF value must be valid too
+        parameter, parameter_uses_node_id, parameter_expr = self._default(
+            section, data_type, low, high, "ParameterValue"
+        )
         return Variable(
             index=index,
             subindex=sub,
@@ -319,13 +345,22 @@ class _EdsReader:
             default_expr=expr,
             parent_name=parent_name,
             default_uses_node_id=uses_node_id,
+            parameter_value=parameter,
+            parameter_expr=parameter_expr,
+            parameter_uses_node_id=parameter_uses_node_id,
         )
 
     def _name(self, section: IniSection) -> str:
         name = section.get("ParameterName")
         if not name:
-            raise self.error(section, section.line, "ParameterName is missing")
+            raise self._absent(section, "ParameterName")
         return name
+
+    def _absent(self, section: IniSection, key: str) -> DictionaryError:
+        """A required key without a value: "missing" when the key is not there, "empty" when it is written as
+        ``key=`` (a generator's placeholder), so the reader knows whether to add the line or fill it in."""
+        state = "empty" if key in section else "missing"
+        return self.error(section, section.line_of(key), f"{key} is {state}")
 
     def _check_keys(self, section: IniSection) -> None:
         for entry in section:
@@ -336,7 +371,7 @@ class _EdsReader:
         text = section.get("DataType")
         if not text:
             if default is None:
-                raise self.error(section, section.line, "DataType is missing")
+                raise self._absent(section, "DataType")
             return default
         code = self._integer(section, "DataType")
         try:
@@ -348,7 +383,7 @@ class _EdsReader:
         text = section.get("AccessType")
         if not text:
             if default is None:
-                raise self.error(section, section.line, "AccessType is missing")
+                raise self._absent(section, "AccessType")
             return default
         try:
             return Access(text.lower())
@@ -368,8 +403,9 @@ class _EdsReader:
 
     def _default(
         self, section: IniSection, data_type: DataType, low: int | float | None, high: int | float | None, key: str
-    ) -> tuple[int | float | str | bytes | None, bool, str | None]:
-        """Read DefaultValue (or a DCF's ParameterValue): syntax, type range, limits, for node IDs 1 and 127."""
+    ) -> _EdsValue:
+        """Read DefaultValue (or a DCF's ParameterValue, or one entry of ``[xxxxValue]``): syntax, type range,
+        limits, for node IDs 1 and 127.  Returns (value without its ``$NODEID`` term, uses ``$NODEID``, the text)."""
         text = section.get(key)
         if text is None or (text == "" and not (data_type.is_text or data_type.is_binary)):
             return None, False, None
@@ -410,9 +446,14 @@ class _EdsReader:
         text = section.get(key)
         if not text:
             if default is None:
-                raise self.error(section, section.line_of(key), f"{key} is missing")
+                raise self._absent(section, key)
             return default
         try:
             return parse_integer(text)
         except ValueSyntaxError as exc:
             raise self.error(section, section.line_of(key), f"{key}: {exc}") from None
+
+
+def _integer_default(var: Variable | None) -> int:
+    """The node-independent integer default of an entry, 0 when it has none (an identity entry without a value)."""
+    return var.default if var is not None and isinstance(var.default, int) else 0

@@ -5,6 +5,8 @@
   (case-insensitive). The constant part is returned together with a flag.
 - REAL32/REAL64: a hexadecimal text is the IEEE-754 bit pattern (what lely's dcf-tools expects, e.g. `0x3F800000`
   is 1.0); any other text is a decimal number (`1.5`, `-2e-3`).
+- TIME_OF_DAY / TIME_DIFFERENCE: "days ms" (`365 43200000`, as Lely's dcf-tools read and write them) or one integer
+  `days << 32 | ms`.
 - VISIBLE_STRING / UNICODE_STRING: the text itself. OCTET_STRING / DOMAIN: hexadecimal digits, two per byte
   (whitespace ignored), e.g. `0102AB`.
 """
@@ -18,6 +20,11 @@ from servostudio.errors import InvalidInput
 from servostudio.od.datatypes import DataType
 
 _NODE_ID = re.compile(r"^\s*\$nodeid\s*(?:\+\s*(?P<after>.+?))?\s*$|^\s*(?P<before>.+?)\s*\+\s*\$nodeid\s*$", re.I)
+
+
+#: CiA 301 TIME_OF_DAY / TIME_DIFFERENCE: 16-bit days and 28-bit milliseconds
+TIME_MAX_DAYS = 0xFFFF
+TIME_MAX_MS = (1 << 28) - 1
 
 
 class ValueSyntaxError(InvalidInput):
@@ -56,6 +63,8 @@ def parse_number(data_type: DataType, text: str, allow_node_id: bool = False) ->
     """`parse_value` for the numeric, BOOLEAN and TIME types, typed as a number for the range checks that follow."""
     if data_type.is_float:
         return _parse_float(data_type, text), False
+    if data_type.is_time:
+        return _parse_time(text), False
     node_id = _NODE_ID.match(text)
     if node_id and "$" in text:
         if not allow_node_id:
@@ -80,6 +89,18 @@ def _parse_float(data_type: DataType, text: str) -> float:
         raise ValueSyntaxError(f"{text!r} is not a number") from None
 
 
+def _parse_time(text: str) -> int:
+    """TIME_OF_DAY / TIME_DIFFERENCE as "days ms" (two integers, as Lely's tools write them) or as the one
+    integer ``days << 32 | ms`` of our own model; both end as that integer."""
+    parts = text.split()
+    if len(parts) != 2:
+        return parse_integer(text)
+    days, ms = (parse_integer(part) for part in parts)
+    if not 0 <= days <= TIME_MAX_DAYS or not 0 <= ms <= TIME_MAX_MS:
+        raise ValueSyntaxError(f"{text!r}: days must be 0..{TIME_MAX_DAYS} and milliseconds 0..{TIME_MAX_MS}")
+    return days << 32 | ms
+
+
 def _parse_hex_bytes(text: str) -> bytes:
     digits = "".join(text.split())
     try:
@@ -93,3 +114,9 @@ def float_bit_pattern(data_type: DataType, value: float) -> str:
     fmt = "<f" if data_type is DataType.REAL32 else "<d"
     digits = data_type.fixed_size * 2
     return f"0x{int.from_bytes(struct.pack(fmt, value), 'little'):0{digits}X}"
+
+
+def time_text(value: int) -> str:
+    """The EDS spelling of a TIME_OF_DAY / TIME_DIFFERENCE value ``days << 32 | ms``: "days ms", the one form both
+    our reader and dcf-tools read."""
+    return f"{value >> 32} {value & 0xFFFFFFFF}"

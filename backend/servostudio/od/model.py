@@ -95,6 +95,8 @@ class Variable:
 
     `default` is the DefaultValue with any `$NODEID` term left out (so "$NODEID+0x180" gives 0x180);
     `default_for(node_id)` adds the node ID back. `default_expr` keeps the text as written in the EDS.
+    A DCF's ParameterValue (the value commissioning configured) is kept the same way in `parameter_value`,
+    `parameter_expr` and `parameter_value_for(node_id)`.
     """
 
     index: int
@@ -119,6 +121,9 @@ class Variable:
     reference: str = ""
     parent_name: str = ""
     default_uses_node_id: bool = False
+    parameter_value: Value | None = None
+    parameter_expr: str | None = None
+    parameter_uses_node_id: bool = False
 
     def __hash__(self) -> int:
         """Hash by address: the `enum` mapping makes the generated field-wise hash impossible."""
@@ -147,9 +152,21 @@ class Variable:
 
     def default_for(self, node_id: int) -> Value | None:
         """DefaultValue with `$NODEID` replaced by `node_id`."""
-        if self.default_uses_node_id and isinstance(self.default, int):
-            return self.default + node_id
-        return self.default
+        return _for_node(self.default, self.default_uses_node_id, node_id)
+
+    def parameter_value_for(self, node_id: int) -> Value | None:
+        """A DCF's ParameterValue with `$NODEID` replaced by `node_id` (None: the file configures nothing here)."""
+        return _for_node(self.parameter_value, self.parameter_uses_node_id, node_id)
+
+    @property
+    def default_node_offset(self) -> int | None:
+        """What a `$NODEID` default adds to the node ID (0x180 for "$NODEID+0x180"); None for a fixed default."""
+        return _node_offset(self.default, self.default_uses_node_id)
+
+    @property
+    def parameter_node_offset(self) -> int | None:
+        """What a `$NODEID` ParameterValue adds to the node ID; None for a fixed or no ParameterValue."""
+        return _node_offset(self.parameter_value, self.parameter_uses_node_id)
 
     def to_physical(self, raw: int | float) -> float:
         """physical = raw * scale + offset (the unit is `self.unit`)."""
@@ -180,6 +197,15 @@ class Variable:
         low, high = self.minimum, self.maximum
         if (low is not None and value < low) or (high is not None and value > high):
             raise OutOfRange(f"{self.label}: {value} is outside {low}..{high}")
+
+
+def _for_node(value: Value | None, uses_node_id: bool, node_id: int) -> Value | None:
+    """An EDS value for one node: the `$NODEID` term is the only part of a value that depends on the node."""
+    return value + node_id if uses_node_id and isinstance(value, int) else value
+
+
+def _node_offset(value: Value | None, uses_node_id: bool) -> int | None:
+    return value if uses_node_id and isinstance(value, int) else None
 
 
 @dataclass

@@ -16,6 +16,7 @@ SEQUENCE.TXT goes through 0x3610 (select) / 0x3611 (26 parameters) with ``servos
 
 from __future__ import annotations
 
+import contextvars
 import enum
 import logging
 import struct
@@ -308,10 +309,11 @@ def run_per_drive(drives: list[Drive], work: Callable[[Drive], T]) -> dict[int, 
     """Run ``work`` on every drive in parallel; the result per node is its value or the exception it raised."""
     results: dict[int, T | Exception] = {}
     with ThreadPoolExecutor(max_workers=max(1, len(drives)), thread_name_prefix="per-drive") as pool:
-        futures = {drive.node: pool.submit(work, drive) for drive in drives}
+        # each drive's thread acts for the caller (motion guard, audit log): a copy of its context apiece
+        futures = {drive.node: pool.submit(contextvars.copy_context().run, work, drive) for drive in drives}
         for node, future in futures.items():
             try:
-                results[node] = future.result()
+                results[node] = future.result()  # the work bounds each of its own waits (`settle`)
             except Exception as error:  # reported per drive, the others go on; a bug is logged as well
                 if not isinstance(error, ServoStudioError):
                     log.exception("node %d: unexpected failure", node)

@@ -1,7 +1,7 @@
 """Device control as the server offers it: the CiA 402 state and the faults of one drive.
 
 Every status word read here is reported to the bus monitor, so ``drive_state`` events follow changes made through
-the API as well; enabling goes through the motion guard (``services.motion``).
+the API as well; every control word goes through the motion guard (``services.motion``).
 """
 
 from __future__ import annotations
@@ -9,6 +9,7 @@ from __future__ import annotations
 from servostudio.drive import control
 from servostudio.drive.access import Drive
 from servostudio.drive.cia402 import State
+from servostudio.services.audit import current_actor
 from servostudio.services.bus import BusConnection
 from servostudio.services.motion import MotionGuard
 
@@ -25,11 +26,14 @@ def drive_state(connection: BusConnection, drive: Drive) -> dict[str, object]:
     }
 
 
-def change_state(
-    connection: BusConnection, motion: MotionGuard, client: str | None, drive: Drive, target: str
-) -> dict[str, object]:
-    """Walk the drive to the state named ``target``; enabling needs the caller's live motion client."""
-    motion.change_state(client, (connection.id, drive.node), drive, State.parse(target))
+def change_state(connection: BusConnection, motion: MotionGuard, drive: Drive, target: str) -> dict[str, object]:
+    """Walk the drive to the state named ``target``.  The motion guard judges every control word on the way;
+    enabling is refused before the first step unless the caller armed the axis (no drive is left half-way up)."""
+    wanted = State.parse(target)
+    if wanted is State.OPERATION_ENABLED:
+        axis = (connection.id, drive.node)
+        motion.require_controller(current_actor(), axis, f"enabling node {drive.node} on bus {connection.id}")
+    control.set_state(drive, wanted)
     return drive_state(connection, drive)
 
 

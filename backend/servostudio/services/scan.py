@@ -45,6 +45,36 @@ class ScanInterrupted(Unavailable):
     """The bus went down or was closed during the scan; what the scan knew before is kept."""
 
 
+class NothingFound(NotFound):
+    """A scan found no node (the CLI's answer: an empty bus is not what a user scans for); the message says why
+    that may be on this kind of bus."""
+
+
+#: why a bus may look empty, by kind; every CAN bus also gets ``_CAN_REASONS``
+_EMPTY_REASONS = {
+    "virtual": "a virtual channel reaches only the buses this process opened on it, so drives simulated by another "
+    "process are not there (reach them with socketcand: servostudio sim --socketcand HOST:PORT)",
+    "sim": "the simulated bus was opened without nodes (name them: sim:1,2,3)",
+    "serial": "check the RS-232 cable and its baud rate (the drive's 0x2300, 19200 by default), and that the drive "
+    "on the link is powered; the link reaches nodes 1-63 through it",
+    "socketcand": "the socketcand server's channel (socketcand:HOST:PORT/CHANNEL, can0 by default) may be another "
+    "one than the drives'",
+}
+_CAN_REASONS = (
+    "the drives are not powered (logic supply), the bit rate differs from the drives' (every node and the "
+    "adapter must use the same), the bus lacks its 120 ohm termination at both ends, or no node ID is set"
+)
+
+
+def empty_scan_hint(connection: BusConnection) -> str:
+    """Why a scan of this bus found no node: the likely reasons for its kind of bus."""
+    kind = connection.spec.kind
+    reasons = [_EMPTY_REASONS[kind]] if kind in _EMPTY_REASONS else []
+    if kind not in ("sim", "serial", "virtual"):
+        reasons.append(_CAN_REASONS)
+    return f"no node answered on {connection.spec}: " + "; or ".join(reasons)
+
+
 def scan(connection: BusConnection, nodes: range | list[int] | None = None) -> list[NodeInfo]:
     """Probe, identify and remember the nodes present among ``nodes`` (default: every node ID).
 
@@ -79,7 +109,9 @@ def _scan(connection: BusConnection, nodes: range | list[int] | None) -> list[No
     for node in candidates:
         connection.nodes.pop(node, None)
     connection.nodes.update({info.node: info for info in found})
-    connection.events.publish({"type": "scan", "bus": connection.id, "nodes": [info.as_dict() for info in found]})
+    hint = None if found else empty_scan_hint(connection)
+    identities = [info.as_dict() for info in found]
+    connection.events.publish({"type": "scan", "bus": connection.id, "nodes": identities, "hint": hint})
     return found
 
 

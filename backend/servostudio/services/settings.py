@@ -52,11 +52,17 @@ class Settings:
     data_dir: Path = field(default_factory=default_data_dir)  # users.json: users, API tokens, password-less choice
     allowed_hosts: tuple[str, ...] = ()  # Host values accepted besides the loopback names and `host`
     allowed_origins: tuple[str, ...] = ()  # browser origins accepted besides the server's own
+    audit_file: Path | None = None  # the audit log (JSON lines); None: ``audit.jsonl`` in ``data_dir``
 
     @classmethod
     def given(cls, **flags: Any) -> Settings:
         """Settings from command-line flags; a flag left out (None) keeps its environment or default value."""
         return replace(cls(), **{name: value for name, value in flags.items() if value is not None})
+
+    @property
+    def audit_path(self) -> Path:
+        """Where the audit log is appended: ``audit_file``, else ``DATA_DIR/audit.jsonl``."""
+        return self.audit_file if self.audit_file is not None else self.data_dir / "audit.jsonl"
 
     @property
     def transfer_roots(self) -> tuple[Path, ...]:

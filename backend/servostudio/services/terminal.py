@@ -7,7 +7,7 @@ the error that object gave, so a missing drive does not blank the other axes.
 
 from __future__ import annotations
 
-from concurrent.futures import Future
+from concurrent.futures import Future, wait
 from dataclasses import dataclass
 
 from servostudio.drive.access import Drive
@@ -46,7 +46,8 @@ class Watch:
 
 
 def sample(manager: ConnectionManager, watch: Watch, timeout: float = 2.0) -> list[dict[str, object]]:
-    """Read every watched object once; one row per item with ``value`` or ``error``."""
+    """Read every watched object once, all within ``timeout`` seconds; one row per item with ``value`` or
+    ``error``."""
     pending: list[tuple[WatchItem, Future | None, str]] = []
     for item in watch.items:
         try:
@@ -54,35 +55,41 @@ def sample(manager: ConnectionManager, watch: Watch, timeout: float = 2.0) -> li
             pending.append((item, drive.submit_read(drive.variable(item.object)), ""))
         except ServoStudioError as error:
             pending.append((item, None, str(error)))
-    rows = []
-    for item, future, refusal in pending:
-        row: dict[str, object] = {"bus": item.bus, "node": item.node, "object": item.object}
-        if future is None:
-            row["error"] = refusal
-        else:
-            try:
-                row["value"] = future.result(timeout).as_dict()
-            except (ServoStudioError, ValueError, TimeoutError) as failure:
-                row["error"] = str(failure)
-        rows.append(row)
-    return rows
+    _wait_for([future for _, future, _ in pending], timeout)
+    return [
+        {"bus": item.bus, "node": item.node, "object": item.object, **_outcome(future, refusal, timeout)}
+        for item, future, refusal in pending
+    ]
 
 
 def read_objects(drive: Drive, keys: list[str], timeout: float = 5.0) -> list[dict[str, object]]:
-    """Read many objects of one node, queued back to back; one row per key with ``value`` or ``error``."""
+    """Read many objects of one node, queued back to back, all within ``timeout`` seconds; one row per key with
+    ``value`` or ``error``."""
     pending: list[tuple[str, Future | None, str]] = []
     for key in keys:
         try:
             pending.append((key, drive.submit_read(drive.variable(key)), ""))
         except ServoStudioError as error:
             pending.append((key, None, str(error)))
-    rows = []
-    for key, future, refusal in pending:
-        row: dict[str, object] = {"object": key, "value": None, "error": refusal or None}
-        if future is not None:
-            try:
-                row["value"] = future.result(timeout).as_dict()
-            except (ServoStudioError, ValueError, TimeoutError) as failure:
-                row["error"] = str(failure)
-        rows.append(row)
-    return rows
+    _wait_for([future for _, future, _ in pending], timeout)
+    return [
+        {"object": key, "value": None, "error": None, **_outcome(future, refusal, timeout)}
+        for key, future, refusal in pending
+    ]
+
+
+def _wait_for(futures: list[Future | None], timeout: float) -> None:
+    """One bounded wait for every read (not one timeout per read: 32 silent objects must not take 32 timeouts)."""
+    wait([future for future in futures if future is not None], timeout)
+
+
+def _outcome(future: Future | None, refusal: str, waited: float) -> dict[str, object]:
+    """A read's ``value``, or its ``error``: refused before it was sent, failed, or no answer in time."""
+    if future is None:
+        return {"error": refusal}
+    if not future.done():
+        return {"error": f"no answer within {waited:g} s"}
+    try:
+        return {"value": future.result(0).as_dict()}
+    except (ServoStudioError, ValueError) as failure:
+        return {"error": str(failure)}

@@ -35,6 +35,7 @@ from servostudio.sim.objects import ObjectStore
 from servostudio.sim.pdo import PdoEngine
 from servostudio.sim.sdo_server import DEFAULT_RESPONSE_TIME, SdoServer
 from servostudio.sim.sequences import SequenceMemory
+from servostudio.sim.simulator_objects import with_simulator_objects
 
 log = logging.getLogger(__name__)
 
@@ -82,7 +83,7 @@ class SimulatedNode:
         self.bus = bus
         self.state = NmtState.INITIALISING
         self._sync_generation = 0
-        self.store = ObjectStore(od, node_id)
+        self.store = ObjectStore(with_simulator_objects(od), node_id)
         self.events = DriveEvents(self.store, self.transmit, lambda: self.state.value, self._emcy_allowed)
         self.sequences = SequenceMemory.for_store(self.store)
         self.events.sequences = self.sequences

@@ -5,7 +5,7 @@ import type { Dictionary, OdVariable } from "../lib/od";
 function sub(subindex: number, access = "rw", save_type = "DRIVEPAR"): OdVariable {
   return {
     subindex, name: `s${subindex}`, data_type: "UNSIGNED16", access, pdo_mappable: false, low: null, high: null, default: 0,
-    unit: "", scale: 1, offset: 0, save_type, group: "", description: "", enum: {}, bits: [], is_pointer: false, reference: "",
+    unit: "", scale: 1, offset: 0, save_type, group: "", description: "", enum: {}, bits: [], is_pointer: false, reference: "", write_level: null,
   };
 }
 

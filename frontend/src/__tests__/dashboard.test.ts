@@ -20,7 +20,7 @@ const mode = entry(0x6060, { name: "Modes of operation", data_type: "INTEGER8", 
 
 function control(overrides: Partial<DeviceControlProps> = {}) {
   const props = {
-    statusword: state<number | null>(null), reachable: state(true), busy: state(false), nmt: state("NMT OPERATIONAL"),
+    statusword: state<number | null>(null), reachable: state(true), busy: state(false), armed: state(true), nmt: state("NMT OPERATIONAL"),
     connection: state(""), mode, activeMode: state<Scalar>(3), activeModeText: state("Profile velocity (3)"),
     onCommand: vi.fn(), onSetMode: vi.fn(), onNmt: vi.fn(), ...overrides,
   };
@@ -61,6 +61,17 @@ describe("device control", () => {
     expect(before.every((button) => !button.disabled)).toBe(true);
     props.busy.val = true;
     expect(before.every((button) => button.disabled)).toBe(true);
+  });
+
+  it("keeps Enable operation disabled until this page armed the axis, and says why", () => {
+    const armed = state(false);
+    const { element } = control({ statusword: state<number | null>(0x0223), armed });
+    const enable = testid(element, "transition-enable_operation") as HTMLButtonElement;
+    expect(enable.disabled).toBe(true);
+    expect(enable.title).toContain("Arm the axis first");
+    expect((testid(element, "transition-shutdown") as HTMLButtonElement).disabled).toBe(false);
+    armed.val = true;
+    expect(enable.disabled).toBe(false);
   });
 
   it("calls the command of a clicked transition and the NMT command of a clicked button", () => {

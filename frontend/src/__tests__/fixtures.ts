@@ -6,7 +6,7 @@ export function variable(overrides: Partial<OdVariable> = {}): OdVariable {
   return {
     subindex: 0, name: "Value", data_type: "UNSIGNED16", access: "rw", pdo_mappable: false, low: null, high: null,
     default: 0, unit: "", scale: 1, offset: 0, save_type: "DRIVEPAR", group: "General", description: "", enum: {},
-    bits: [], is_pointer: false, reference: "", ...overrides,
+    bits: [], is_pointer: false, reference: "", write_level: null, ...overrides,
   } as OdVariable;
 }
 

@@ -7,7 +7,7 @@ function variable(subindex: number, name: string, extra: Partial<OdVariable> = {
   return {
     subindex, name, data_type: "UNSIGNED16", access: "rw", pdo_mappable: false, low: null, high: null, default: 0,
     unit: "", scale: 1, offset: 0, save_type: "NONE", group: "", description: "", enum: {}, bits: [],
-    is_pointer: false, reference: "", ...extra,
+    is_pointer: false, reference: "", write_level: null, ...extra,
   };
 }
 

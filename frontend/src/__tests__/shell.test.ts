@@ -73,9 +73,11 @@ describe("top bar", () => {
     app.live.setBuses([{ name: "sim", state: "connected" }, { name: "can0", state: "disconnected" }]);
     expect(buses.textContent).toBe("sim: connected · can0: disconnected");
     expect(buses.querySelector(".dot")!.className).toBe("dot warn");
-    expect(user.textContent).toBe("local operator");
+    expect(user.textContent).toBe("not logged in");
     app.live.setUser({ name: "local", level: "administrator" });
-    expect(user.textContent).toBe("local · administrator");
+    expect(user.textContent).toBe("local · administrator"); // password-less: nobody to log out
+    app.live.setUser({ name: "olga", level: "operator" });
+    expect(user.textContent).toBe("olga · operatorLog out");
     const server = state({ state: "connecting" as "connecting" | "online" | "offline", text: "Connecting to server…" });
     const pill = serverStatus(server);
     server.val = { state: "online", text: "Server online · v1" };

@@ -48,6 +48,25 @@ export async function errorOf(path: string, response: Response): Promise<ApiErro
   return new ApiError(response.status, fallback, kind, error);
 }
 
+/** The cookie holding the session's CSRF token, and the header every state-changing request repeats it in. */
+const CSRF_COOKIE = "servostudio_csrf";
+const CSRF_HEADER = "X-CSRF-Token";
+const SAFE_METHODS = new Set(["GET", "HEAD"]);
+
+/** The session's CSRF token: only a page of the server's own origin can read the cookie, so a foreign page cannot
+ * forge the header (docs/security.md). Null without a session (password-less use, no login yet). */
+export function csrfToken(cookies: string = document.cookie): string | null {
+  const entry = cookies.split("; ").find((cookie) => cookie.startsWith(`${CSRF_COOKIE}=`));
+  return entry ? decodeURIComponent(entry.slice(CSRF_COOKIE.length + 1)) : null;
+}
+
+let whenUnauthenticated: () => void = () => undefined;
+
+/** What to do when the server answers 401 (nobody logged in, the session ended): the app shows its login page. */
+export function onUnauthenticated(handler: () => void): void {
+  whenUnauthenticated = handler;
+}
+
 let motionClient: string | null = null;
 
 /** The id the event socket announced. Every request names it, so the server can quick-stop the axes this page
@@ -69,6 +88,8 @@ export async function request<T>(
 ): Promise<T> {
   const init: RequestInit = { method, headers: { Accept: "application/json" }, signal };
   if (motionClient) (init.headers as Record<string, string>)["X-Servo-Client"] = motionClient;
+  const csrf = SAFE_METHODS.has(method) ? null : csrfToken();
+  if (csrf) (init.headers as Record<string, string>)[CSRF_HEADER] = csrf;
   if (body instanceof FormData || body instanceof Blob) {
     init.body = body;
     if (body instanceof Blob && body.type) (init.headers as Record<string, string>)["Content-Type"] = body.type;
@@ -77,6 +98,7 @@ export async function request<T>(
     (init.headers as Record<string, string>)["Content-Type"] = "application/json";
   }
   const response = await fetchImpl(path, init);
+  if (response.status === 401) whenUnauthenticated();
   if (!response.ok) throw await errorOf(path, response);
   if (response.status === 204) return undefined as T;
   return (await response.json()) as T;

@@ -58,7 +58,7 @@ export function serverBus(bus: string): string {
 const nodePath = (bus: string, node: number) => `/api/buses/${e(serverBus(bus))}/nodes/${node}`;
 
 /** Drive calls wait until the bus mapping is known; the server identifies a node on first use (no scan needed). */
-async function whenMapped<T>(work: () => Promise<T>): Promise<T> {
+export async function whenMapped<T>(work: () => Promise<T>): Promise<T> {
   await aliasesKnown;
   return work();
 }

@@ -8,7 +8,7 @@ import { get, post } from "./api";
 import type { LiveEvent, LiveHub } from "./live";
 import type { Narrow, Schemas } from "./schema-types";
 
-export type JobState = "running" | "done" | "failed" | "cancelled";
+export type JobState = "running" | "done" | "partial" | "failed" | "cancelled";
 
 /** A server job (`JobModel`); its `result` depends on the operation, which the schema leaves open. */
 export type JobInfo<R = unknown> = Narrow<Schemas["JobModel"], { state: JobState; result?: R | null }>;

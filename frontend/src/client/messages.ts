@@ -60,6 +60,17 @@ export interface EventMap {
   /** A job ended (or changed state): the job as `GET /api/jobs/{id}` answers it. */
   job: { type: "job" } & JobModel;
   overflow: { type: "overflow"; time: number; detail: string };
+  /** The controller of an axis changed (docs/motion-safety.md): who holds it now, and what happened. */
+  control: NodeEvent & {
+    type: "control";
+    event: "armed" | "released" | "taken_over" | "lost";
+    holder: Schemas["HolderModel"] | null;
+    requests: Schemas["HolderModel"][];
+    by: { client: string | null; user?: string };
+    previous?: Schemas["HolderModel"] | null;
+  };
+  /** Another client asks this page, the axis's controller, to release the axis. */
+  control_request: NodeEvent & { type: "control_request"; to: string; from: { client: string; user: string } };
   /** Not from the server: the event socket (re)opened. */
   ws_open: { type: "ws_open" };
 }

@@ -4,6 +4,40 @@
  */
 
 export interface paths {
+    "/api/audit": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        /** Audit log entries, newest first (filters: axis, user, project, action, since, until; paging) */
+        get: operations["list_entries_api_audit_get"];
+        put?: never;
+        post?: never;
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
+    "/api/audit/export": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        /** Every matching audit entry, oldest first, as CSV or JSON lines */
+        get: operations["export_entries_api_audit_export_get"];
+        put?: never;
+        post?: never;
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
     "/api/buses": {
         parameters: {
             query?: never;
@@ -74,6 +108,91 @@ export interface paths {
         patch?: never;
         trace?: never;
     };
+    "/api/buses/{bus}/nodes/{node}/control": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        /** Who holds the axis */
+        get: operations["get_control_api_buses__bus__nodes__node__control_get"];
+        put?: never;
+        post?: never;
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
+    "/api/buses/{bus}/nodes/{node}/control/arm": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        get?: never;
+        put?: never;
+        /** Arm the axis: the caller's client becomes its controller (409 naming the holder if another has it) */
+        post: operations["arm_api_buses__bus__nodes__node__control_arm_post"];
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
+    "/api/buses/{bus}/nodes/{node}/control/release": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        get?: never;
+        put?: never;
+        /** Disarm the axis; if it is still enabled it gets a quick stop */
+        post: operations["release_api_buses__bus__nodes__node__control_release_post"];
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
+    "/api/buses/{bus}/nodes/{node}/control/request": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        get?: never;
+        put?: never;
+        /** Ask the axis's controller (over its event socket) to release the axis */
+        post: operations["request_api_buses__bus__nodes__node__control_request_post"];
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
+    "/api/buses/{bus}/nodes/{node}/control/take-over": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        get?: never;
+        put?: never;
+        /** Take the axis over from its controller (Expert; logged; the axis keeps its state) */
+        post: operations["take_over_api_buses__bus__nodes__node__control_take_over_post"];
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
     "/api/buses/{bus}/nodes/{node}/faults": {
         parameters: {
             query?: never;
@@ -135,7 +254,10 @@ export interface paths {
         };
         /** Read an object by address (0x6041, 0x60F9,2), name, or profile name (statusword) */
         get: operations["read_object_api_buses__bus__nodes__node__objects__key__get"];
-        /** Write an object; access, type and range are checked before anything is sent */
+        /**
+         * Write an object; access, type and range are checked before anything is sent
+         * @description A motion object (control word, mode, target) needs the axis's armed controller: send X-Servo-Client.
+         */
         put: operations["write_object_api_buses__bus__nodes__node__objects__key__put"];
         post?: never;
         delete?: never;
@@ -161,6 +283,159 @@ export interface paths {
         patch?: never;
         trace?: never;
     };
+    "/api/buses/{bus}/nodes/{node}/scope": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        /** The node's recorder: channels, buffer, base period, status, and the presets it can run */
+        get: operations["get_scope_api_buses__bus__nodes__node__scope_get"];
+        put?: never;
+        post?: never;
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
+    "/api/buses/{bus}/nodes/{node}/scope/captures": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        get?: never;
+        put?: never;
+        /** Arm the recorder and capture as a job (single: one recording; normal, auto: until stopped) */
+        post: operations["start_capture_api_buses__bus__nodes__node__scope_captures_post"];
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
+    "/api/buses/{bus}/nodes/{node}/scope/captures/{capture_id}": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        /** A capture the server keeps (its id comes in the job's result and progress events) */
+        get: operations["get_capture_api_buses__bus__nodes__node__scope_captures__capture_id__get"];
+        put?: never;
+        post?: never;
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
+    "/api/buses/{bus}/nodes/{node}/scope/captures/{capture_id}/csv": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        /** A capture as CSV (docs/scope.md, capture file format) */
+        get: operations["get_capture_csv_api_buses__bus__nodes__node__scope_captures__capture_id__csv_get"];
+        put?: never;
+        post?: never;
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
+    "/api/buses/{bus}/nodes/{node}/scope/captures/{capture_id}/html": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        /** A capture as a standalone interactive HTML file (opens offline) */
+        get: operations["get_capture_html_api_buses__bus__nodes__node__scope_captures__capture_id__html_get"];
+        put?: never;
+        post?: never;
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
+    "/api/buses/{bus}/nodes/{node}/scope/check": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        get?: never;
+        put?: never;
+        /** Check a capture definition against the drive without arming anything (422 says why not) */
+        post: operations["check_capture_api_buses__bus__nodes__node__scope_check_post"];
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
+    "/api/buses/{bus}/nodes/{node}/scope/force": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        get?: never;
+        put?: never;
+        /** Force the trigger: the next sample is the trigger sample (while filling or waiting) */
+        post: operations["force_trigger_api_buses__bus__nodes__node__scope_force_post"];
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
+    "/api/buses/{bus}/nodes/{node}/scope/status": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        /** The recorder's status and the node's running capture job */
+        get: operations["get_status_api_buses__bus__nodes__node__scope_status_get"];
+        put?: never;
+        post?: never;
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
+    "/api/buses/{bus}/nodes/{node}/scope/stop": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        get?: never;
+        put?: never;
+        /** Stop the node's capture job and the recorder (the last complete recording stays readable) */
+        post: operations["stop_capture_api_buses__bus__nodes__node__scope_stop_post"];
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
     "/api/buses/{bus}/nodes/{node}/state": {
         parameters: {
             query?: never;
@@ -172,7 +447,7 @@ export interface paths {
         get: operations["get_state_api_buses__bus__nodes__node__state_get"];
         /**
          * Walk the CiA 402 state machine to a target state
-         * @description Enabling (operation-enabled) needs a live motion client, which then answers for the axis.
+         * @description Enabling (operation-enabled) needs the axis armed by the caller's live client (X-Servo-Client).
          */
         put: operations["put_state_api_buses__bus__nodes__node__state_put"];
         post?: never;
@@ -208,8 +483,28 @@ export interface paths {
         };
         get?: never;
         put?: never;
-        /** Find and identify every node (1–127; 1–63 on a serial link) */
+        /**
+         * Find and identify every node (1–127; 1–63 on a serial link)
+         * @description An empty bus is an answer (200, ``[]``); the header then says why it may look empty.
+         */
         post: operations["scan_bus_api_buses__bus__scan_post"];
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
+    "/api/control": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        /** Every armed axis and its controller */
+        get: operations["list_controls_api_control_get"];
+        put?: never;
+        post?: never;
         delete?: never;
         options?: never;
         head?: never;
@@ -356,6 +651,26 @@ export interface paths {
         patch?: never;
         trace?: never;
     };
+    "/api/me/password": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        get?: never;
+        /**
+         * Change Password
+         * @description Change one's own password; the current one is asked again (rate-limited like a login).
+         */
+        put: operations["change_password_api_me_password_put"];
+        post?: never;
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
     "/api/motors": {
         parameters: {
             query?: never;
@@ -426,7 +741,8 @@ export interface paths {
         put?: never;
         /**
          * Unarchive
-         * @description Body: the zip archive (``application/zip``). Its size is limited before anything is unpacked.
+         * @description Body: the zip archive (``application/zip``). Its size is limited (``api.limits``) before anything is
+         *     unpacked.
          */
         post: operations["unarchive_api_projects_unarchive_post"];
         delete?: never;
@@ -751,10 +1067,238 @@ export interface paths {
         patch?: never;
         trace?: never;
     };
+    "/api/projects/{project}/axes/{axis}/captures": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        /** The captures saved under the axis (a damaged one names its file and line in `error`) */
+        get: operations["list_saved_api_projects__project__axes__axis__captures_get"];
+        put?: never;
+        /** Save a live capture under the axis as CSV + JSON sidecar */
+        post: operations["save_capture_api_projects__project__axes__axis__captures_post"];
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
+    "/api/projects/{project}/axes/{axis}/captures/{name}": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        /** Re-open a saved capture (422 names the file and line of a damaged one) */
+        get: operations["open_saved_api_projects__project__axes__axis__captures__name__get"];
+        put?: never;
+        post?: never;
+        /** Delete a saved capture (changing the project's records needs Expert, like the project itself) */
+        delete: operations["delete_saved_api_projects__project__axes__axis__captures__name__delete"];
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
+    "/api/projects/{project}/axes/{axis}/captures/{name}/csv": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        /** A saved capture's CSV */
+        get: operations["saved_csv_api_projects__project__axes__axis__captures__name__csv_get"];
+        put?: never;
+        post?: never;
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
+    "/api/projects/{project}/axes/{axis}/captures/{name}/html": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        /** A saved capture as a standalone interactive HTML file */
+        get: operations["saved_html_api_projects__project__axes__axis__captures__name__html_get"];
+        put?: never;
+        post?: never;
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
+    "/api/session": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        get?: never;
+        put?: never;
+        /**
+         * Log In
+         * @description Log in: sets the session cookie (HttpOnly) and the CSRF cookie, whose value every state-changing request
+         *     repeats in ``X-CSRF-Token``. Failed logins are limited: 5 per user name and 20 per address in 15 minutes.
+         */
+        post: operations["log_in_api_session_post"];
+        /** Log Out */
+        delete: operations["log_out_api_session_delete"];
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
+    "/api/setup": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        /** Get Setup */
+        get: operations["get_setup_api_setup_get"];
+        put?: never;
+        /**
+         * Post Setup
+         * @description Redeem the setup link once: set the administrator (logged in at once), or choose password-less mode
+         *     (loopback only; answers null).
+         */
+        post: operations["post_setup_api_setup_post"];
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
+    "/api/tokens": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        /**
+         * List Tokens
+         * @description One's own tokens; an administrator sees every token.
+         */
+        get: operations["list_tokens_api_tokens_get"];
+        put?: never;
+        /** Create Token */
+        post: operations["create_token_api_tokens_post"];
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
+    "/api/tokens/{token_id}": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        get?: never;
+        put?: never;
+        post?: never;
+        /** Revoke Token */
+        delete: operations["revoke_token_api_tokens__token_id__delete"];
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
+    "/api/users": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        /** List Users */
+        get: operations["list_users_api_users_get"];
+        put?: never;
+        /** Add User */
+        post: operations["add_user_api_users_post"];
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
+    "/api/users/{name}": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        get?: never;
+        put?: never;
+        post?: never;
+        /**
+         * Remove User
+         * @description Remove the user, its sessions and its tokens (never the last administrator: 409).
+         */
+        delete: operations["remove_user_api_users__name__delete"];
+        options?: never;
+        head?: never;
+        /**
+         * Change User
+         * @description A new level applies to the user's sessions at their next request; its tokens keep their own level.
+         */
+        patch: operations["change_user_api_users__name__patch"];
+        trace?: never;
+    };
 }
 export type webhooks = Record<string, never>;
 export interface components {
     schemas: {
+        /** AccountModel */
+        AccountModel: {
+            /**
+             * Created
+             * @description seconds since the epoch
+             */
+            created: number;
+            /** @example administrator */
+            level: components["schemas"]["Level"];
+            /**
+             * Name
+             * @example local
+             */
+            name: string;
+        };
+        /** AuditPageModel */
+        AuditPageModel: {
+            /**
+             * Entries
+             * @description newest first: {seq, time, user, client, action, axis, project, project_axis, object, name, old, new, result, detail}
+             */
+            entries: {
+                [key: string]: unknown;
+            }[];
+            /** Limit */
+            limit: number;
+            /** Offset */
+            offset: number;
+            /**
+             * Total
+             * @description entries matching the filters
+             */
+            total: number;
+        };
         /** AxisChoiceModel */
         AxisChoiceModel: {
             /** Changed */
@@ -765,6 +1309,26 @@ export interface components {
              */
             notes: string[];
             project: components["schemas"]["ProjectModel"];
+        };
+        /** AxisControlModel */
+        AxisControlModel: {
+            /**
+             * Bus
+             * @example sim
+             */
+            bus: string;
+            /** @description the axis's controller; null: nobody holds it */
+            holder: components["schemas"]["HolderModel"] | null;
+            /**
+             * Node
+             * @example 1
+             */
+            node: number;
+            /**
+             * Requests
+             * @description clients that asked the holder for the axis
+             */
+            requests: components["schemas"]["HolderModel"][];
         };
         /** AxisCreate */
         AxisCreate: {
@@ -987,6 +1551,124 @@ export interface components {
             /** Spec */
             spec: string;
         };
+        /** CaptureModel */
+        CaptureModel: {
+            /** Captured At */
+            captured_at: string;
+            /** Channels */
+            channels: components["schemas"]["ChannelModel"][];
+            definition: components["schemas"]["CaptureRequest"];
+            drive: components["schemas"]["DriveIdentityModel"];
+            /**
+             * Id
+             * @description the server's id of a live capture (it keeps the latest ones)
+             */
+            id?: string | null;
+            /**
+             * Name
+             * @description the name of a capture saved in a project
+             */
+            name?: string | null;
+            /** Period Ns */
+            period_ns: number;
+            /** Samples */
+            samples: number;
+            /** Source */
+            source: string;
+            /** Trigger */
+            trigger: string;
+            /**
+             * Trigger Index
+             * @description the trigger sample: time 0
+             */
+            trigger_index: number;
+            /**
+             * Values
+             * @description physical values, one list per channel
+             */
+            values: (number | null)[][];
+        };
+        /**
+         * CaptureRequest
+         * @description A capture definition; the drive's dictionary and recorder check it before anything is armed.
+         * @example {
+         *       "channels": [
+         *         "0x60FF,0",
+         *         "0x606C,0",
+         *         "0x6078,0",
+         *         "0x6041,0"
+         *       ],
+         *       "mode": "single",
+         *       "period_us": 250,
+         *       "pre_trigger_pct": 20,
+         *       "samples": 2048,
+         *       "trigger": {
+         *         "edge": "rising",
+         *         "level": 20480,
+         *         "source": "0x606C,0"
+         *       }
+         *     }
+         */
+        CaptureRequest: {
+            /**
+             * Auto Timeout Ms
+             * @default 100
+             */
+            auto_timeout_ms: number;
+            /**
+             * Channels
+             * @description objects by address or name
+             */
+            channels: string[];
+            /** Duration S */
+            duration_s?: number | null;
+            /**
+             * Mode
+             * @default single
+             * @enum {string}
+             */
+            mode: "single" | "normal" | "auto";
+            /**
+             * Period Us
+             * @description a multiple of the drive's base period
+             * @default 250
+             */
+            period_us: number;
+            /**
+             * Pre Trigger Pct
+             * @default 0
+             */
+            pre_trigger_pct: number;
+            /**
+             * Samples
+             * @description depth; else from duration_s, else the buffer
+             */
+            samples?: number | null;
+            /**
+             * Timeout S
+             * @description give up when no recording completes by then
+             */
+            timeout_s?: number | null;
+            trigger?: components["schemas"]["TriggerModel"];
+        };
+        /** ChannelModel */
+        ChannelModel: {
+            /** Data Type */
+            data_type: string;
+            /**
+             * Key
+             * @example 0x606C,0
+             */
+            key: string;
+            /** Name */
+            name: string;
+            /** Offset */
+            offset: number;
+            /** Scale */
+            scale: number;
+            /** Unit */
+            unit: string;
+        };
         /** CommissionRequest */
         CommissionRequest: {
             /**
@@ -1093,6 +1775,27 @@ export interface components {
             /** Vendor Id */
             vendor_id: number;
         };
+        /** DriveIdentityModel */
+        DriveIdentityModel: {
+            /** Bus */
+            bus: string;
+            /** Device */
+            device: string;
+            /** Node */
+            node: number;
+            /** Product Code */
+            product_code: number | null;
+            /** Product Name */
+            product_name: string;
+            /** Revision */
+            revision: number | null;
+            /** Serial Number */
+            serial_number: number | null;
+            /** Software Version */
+            software_version: string | null;
+            /** Vendor Id */
+            vendor_id: number | null;
+        };
         /**
          * DriveState
          * @example {
@@ -1160,12 +1863,30 @@ export interface components {
             /** Bits */
             bits: components["schemas"]["BitFieldModel"][];
             /**
+             * Configured
+             * @description a DCF's ParameterValue (the value commissioning configured), '$NODEID' kept as default
+             */
+            configured?: number | string | null;
+            /**
+             * Configured Node Offset
+             * @description for a '$NODEID' ParameterValue: the configured value for node n is n + this offset
+             */
+            configured_node_offset?: number | null;
+            /**
              * Data Type
              * @example UNSIGNED16
              */
             data_type: string;
-            /** Default */
+            /**
+             * Default
+             * @description DefaultValue; a default that depends on the node ID stays the EDS expression ('$NODEID+0x180')
+             */
             default: number | string | null;
+            /**
+             * Default Node Offset
+             * @description for a '$NODEID' default: the value for node n is n + this offset; null otherwise
+             */
+            default_node_offset?: number | null;
             /** Description */
             description: string;
             /** Enum */
@@ -1199,6 +1920,8 @@ export interface components {
             subindex: number;
             /** Unit */
             unit: string;
+            /** @description the lowest user level that may write it (null: nobody, read-only); docs/security.md */
+            write_level: components["schemas"]["Level"] | null;
         };
         /**
          * ErrorBody
@@ -1232,6 +1955,30 @@ export interface components {
          * @enum {string}
          */
         ErrorKind: "not_found" | "invalid_input" | "too_large" | "conflict" | "refused_for_safety" | "communication" | "unavailable" | "timeout" | "unauthenticated" | "forbidden" | "rate_limited" | "internal";
+        /**
+         * FaultCauseModel
+         * @description An object a failed procedure needed, seen at 0 or out of its range: the cause the drive does not report.
+         */
+        FaultCauseModel: {
+            /**
+             * Needed By
+             * @example auto-tuning
+             */
+            needed_by: string;
+            /**
+             * Object
+             * @example 0x6410,11 Motor data.Torque constant
+             */
+            object: string;
+            /**
+             * Problem
+             * @example is 0
+             * @example is outside 1..24
+             */
+            problem: string;
+            /** Value */
+            value: number;
+        };
         /** FaultInfoModel */
         FaultInfoModel: {
             /** Cia402 Code */
@@ -1264,6 +2011,11 @@ export interface components {
          *     }
          */
         FaultReportModel: {
+            /**
+             * Causes
+             * @description what the tool sees behind a procedure fault (empty: nothing it can see)
+             */
+            causes?: components["schemas"]["FaultCauseModel"][];
             /** Error Code */
             error_code: number;
             /** Error Text */
@@ -1287,6 +2039,24 @@ export interface components {
             status: string;
             /** Version */
             version: string;
+        };
+        /** HolderModel */
+        HolderModel: {
+            /**
+             * Client
+             * @example 3f9a1c0de2b47a65
+             */
+            client: string;
+            /**
+             * Since
+             * @description Unix time it armed (or asked for) the axis
+             */
+            since: number;
+            /**
+             * User
+             * @example local
+             */
+            user: string;
         };
         /**
          * JobModel
@@ -1312,6 +2082,22 @@ export interface components {
             started: number;
             /** State */
             state: string;
+        };
+        /**
+         * Level
+         * @description A user level; members are listed from the lowest to the highest.
+         * @enum {string}
+         */
+        Level: "operator" | "maintenance" | "expert" | "administrator";
+        /** Login */
+        Login: {
+            /**
+             * Name
+             * @example alice
+             */
+            name: string;
+            /** Password */
+            password: string;
         };
         /** MotorChoice */
         MotorChoice: {
@@ -1367,6 +2153,42 @@ export interface components {
             new_name: string;
             /** Revision */
             revision?: string | null;
+        };
+        /** NewToken */
+        NewToken: {
+            /** Created */
+            created: number;
+            /** Expires */
+            expires: number;
+            /** Id */
+            id: string;
+            /** Label */
+            label: string;
+            level: components["schemas"]["Level"];
+            /**
+             * Owner
+             * @description who created it (null: made from the data directory)
+             */
+            owner: string | null;
+            /**
+             * Token
+             * @description the token itself, shown this once: send it as 'Authorization: Bearer …'
+             */
+            token: string;
+        };
+        /** NewUser */
+        NewUser: {
+            level: components["schemas"]["Level"];
+            /**
+             * Name
+             * @example alice
+             */
+            name: string;
+            /**
+             * Password
+             * @description at least 10 characters
+             */
+            password: string;
         };
         /**
          * NmtRequest
@@ -1578,6 +2400,46 @@ export interface components {
                 [key: string]: number | string;
             };
         };
+        /** PasswordChange */
+        PasswordChange: {
+            /** Current */
+            current: string;
+            /**
+             * New
+             * @description at least 10 characters
+             */
+            new: string;
+        };
+        /**
+         * PlanModel
+         * @description A definition the drive accepts, as the recorder will run it.
+         */
+        PlanModel: {
+            /** Bytes */
+            bytes: number;
+            /** Channels */
+            channels: components["schemas"]["ChannelModel"][];
+            /** Multiplier */
+            multiplier: number;
+            /** Period Ns */
+            period_ns: number;
+            /** Pre Trigger */
+            pre_trigger: number;
+            /** Record Size */
+            record_size: number;
+            /** Samples */
+            samples: number;
+        };
+        /** PresetModel */
+        PresetModel: {
+            definition: components["schemas"]["CaptureRequest"];
+            /** Description */
+            description: string;
+            /** Key */
+            key: string;
+            /** Title */
+            title: string;
+        };
         /** ProjectCreate */
         ProjectCreate: {
             /**
@@ -1656,6 +2518,24 @@ export interface components {
             object: string;
             value?: components["schemas"]["ObjectValueModel"] | null;
         };
+        /** RecorderStatus */
+        RecorderStatus: {
+            /**
+             * Counter
+             * @description recordings completed (wraps at 65536)
+             */
+            counter: number;
+            /**
+             * Job
+             * @description the node's capture job while it runs
+             */
+            job?: string | null;
+            /**
+             * Status
+             * @description idle, filling, waiting, recording or done
+             */
+            status: string;
+        };
         /**
          * RestoreRequest
          * @example {
@@ -1691,6 +2571,41 @@ export interface components {
              * @default true
              */
             store: boolean;
+        };
+        /** SaveRequest */
+        SaveRequest: {
+            /**
+             * Capture
+             * @description id of a live capture
+             */
+            capture: string;
+            /**
+             * Name
+             * @description default: the time of capture
+             */
+            name?: string | null;
+        };
+        /** SavedCaptureModel */
+        SavedCaptureModel: {
+            /** Captured At */
+            captured_at: string;
+            /** Channels */
+            channels: string[];
+            /**
+             * Error
+             * @description why the capture cannot be read (file and line)
+             */
+            error?: string | null;
+            /** Name */
+            name: string;
+            /** Period Ns */
+            period_ns: number;
+            /** Samples */
+            samples: number;
+            /** Source */
+            source: string;
+            /** Trigger */
+            trigger: string;
         };
         /** ScanRequest */
         ScanRequest: {
@@ -1745,6 +2660,25 @@ export interface components {
              */
             status: string;
         };
+        /**
+         * ScopeInfo
+         * @description The drive's recorder: its limits, its status and the presets this drive can run.
+         */
+        ScopeInfo: {
+            /** Base Period Ns */
+            base_period_ns: number;
+            /**
+             * Capacity
+             * @description bytes of one recording
+             */
+            capacity: number;
+            /** Channels */
+            channels: number;
+            /** Presets */
+            presets: components["schemas"]["PresetModel"][];
+            /** Status */
+            status: string;
+        };
         /** SettingModel */
         SettingModel: {
             /** Index */
@@ -1755,6 +2689,43 @@ export interface components {
             value: number;
             /** Why */
             why: string;
+        };
+        /** SetupRequest */
+        SetupRequest: {
+            /**
+             * Name
+             * @description the administrator's name (unless passwordless)
+             */
+            name?: string | null;
+            /**
+             * Password
+             * @description the administrator's password (unless passwordless)
+             */
+            password?: string | null;
+            /**
+             * Passwordless
+             * @description no users: whoever is on this machine is the administrator
+             * @default false
+             */
+            passwordless: boolean;
+            /**
+             * Token
+             * @description the token of the setup link the server printed at start
+             */
+            token: string;
+        };
+        /** SetupStatus */
+        SetupStatus: {
+            /**
+             * Needed
+             * @description no user and no password-less choice yet: the setup link is waiting
+             */
+            needed: boolean;
+            /**
+             * Passwordless
+             * @description the password-less single-user mode is on
+             */
+            passwordless: boolean;
         };
         /**
          * StateRequest
@@ -1812,13 +2783,70 @@ export interface components {
             /** Title */
             title: string;
         };
-        /** UserModel */
-        UserModel: {
+        /** TokenModel */
+        TokenModel: {
+            /** Created */
+            created: number;
+            /** Expires */
+            expires: number;
+            /** Id */
+            id: string;
+            /** Label */
+            label: string;
+            level: components["schemas"]["Level"];
+            /**
+             * Owner
+             * @description who created it (null: made from the data directory)
+             */
+            owner: string | null;
+        };
+        /** TokenRequest */
+        TokenRequest: {
+            /**
+             * Days
+             * @description days until it expires
+             * @default 30
+             */
+            days: number;
+            /**
+             * Label
+             * @description what the token is for
+             * @default
+             */
+            label: string;
+            /** @description at most the caller's own level */
+            level: components["schemas"]["Level"];
+        };
+        /** TriggerModel */
+        TriggerModel: {
+            /**
+             * Edge
+             * @default rising
+             * @enum {string}
+             */
+            edge: "rising" | "falling" | "either";
             /**
              * Level
-             * @example administrator
+             * @description in the source's physical unit
+             * @default 0
              */
-            level: string;
+            level: number;
+            /**
+             * Source
+             * @description object or channel that triggers; none: immediate
+             */
+            source?: string | null;
+        };
+        /** UserChange */
+        UserChange: {
+            level?: components["schemas"]["Level"] | null;
+            /** Password */
+            password?: string | null;
+        };
+        /** UserModel */
+        UserModel: {
+            /** @example administrator */
+            level: components["schemas"]["Level"];
             /**
              * Name
              * @example local
@@ -1848,6 +2876,110 @@ export interface components {
 }
 export type $defs = Record<string, never>;
 export interface operations {
+    list_entries_api_audit_get: {
+        parameters: {
+            query?: {
+                /** @description BUS:NODE, e.g. sim:1 */
+                axis?: string | null;
+                user?: string | null;
+                project?: string | null;
+                /** @description drive_write, project_write, arm, enable, stop, … */
+                action?: string | null;
+                /** @description ISO 8601 time or an age (30m, 2h, 7d) */
+                since?: string | null;
+                /** @description ISO 8601 time or an age */
+                until?: string | null;
+                offset?: number;
+                limit?: number;
+            };
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        requestBody?: never;
+        responses: {
+            /** @description Successful Response */
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["AuditPageModel"];
+                };
+            };
+            /** @description `invalid_input`: refused before anything was sent or written */
+            422: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `internal`: a bug: logged with the request id */
+            500: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+        };
+    };
+    export_entries_api_audit_export_get: {
+        parameters: {
+            query?: {
+                format?: string;
+                /** @description BUS:NODE, e.g. sim:1 */
+                axis?: string | null;
+                user?: string | null;
+                project?: string | null;
+                /** @description drive_write, project_write, arm, enable, stop, … */
+                action?: string | null;
+                /** @description ISO 8601 time or an age (30m, 2h, 7d) */
+                since?: string | null;
+                /** @description ISO 8601 time or an age */
+                until?: string | null;
+                offset?: number;
+                limit?: number;
+            };
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        requestBody?: never;
+        responses: {
+            /** @description Successful Response */
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/x-ndjson": unknown;
+                    "text/csv": unknown;
+                };
+            };
+            /** @description `invalid_input`: refused before anything was sent or written */
+            422: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `internal`: a bug: logged with the request id */
+            500: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+        };
+    };
     list_buses_api_buses_get: {
         parameters: {
             query?: never;
@@ -1985,7 +3117,10 @@ export interface operations {
     get_bus_api_buses__bus__get: {
         parameters: {
             query?: never;
-            header?: never;
+            header?: {
+                /** @description id announced by /api/ws/events; required for motion */
+                "X-Servo-Client"?: string | null;
+            };
             path: {
                 bus: string;
             };
@@ -2117,7 +3252,10 @@ export interface operations {
     start_backup_api_buses__bus__backup_post: {
         parameters: {
             query?: never;
-            header?: never;
+            header?: {
+                /** @description id announced by /api/ws/events; required for motion */
+                "X-Servo-Client"?: string | null;
+            };
             path: {
                 bus: string;
             };
@@ -2170,7 +3308,10 @@ export interface operations {
     nmt_api_buses__bus__nmt_post: {
         parameters: {
             query?: never;
-            header?: never;
+            header?: {
+                /** @description id announced by /api/ws/events; required for motion */
+                "X-Servo-Client"?: string | null;
+            };
             path: {
                 bus: string;
             };
@@ -2236,13 +3377,369 @@ export interface operations {
             };
         };
     };
+    get_control_api_buses__bus__nodes__node__control_get: {
+        parameters: {
+            query?: never;
+            header?: {
+                /** @description id announced by /api/ws/events; required for motion */
+                "X-Servo-Client"?: string | null;
+            };
+            path: {
+                /** @description node ID */
+                node: number;
+                bus: string;
+            };
+            cookie?: never;
+        };
+        requestBody?: never;
+        responses: {
+            /** @description Successful Response */
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["AxisControlModel"];
+                };
+            };
+            /** @description `not_found`: unknown bus, node, job, object, device, project, axis or motor */
+            404: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `conflict`: the current state refuses it: a changed project, a taken name, the drive */
+            409: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `invalid_input`: refused before anything was sent or written */
+            422: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `internal`: a bug: logged with the request id */
+            500: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+        };
+    };
+    arm_api_buses__bus__nodes__node__control_arm_post: {
+        parameters: {
+            query?: never;
+            header?: {
+                /** @description id announced by /api/ws/events; required for motion */
+                "X-Servo-Client"?: string | null;
+            };
+            path: {
+                /** @description node ID */
+                node: number;
+                bus: string;
+            };
+            cookie?: never;
+        };
+        requestBody?: never;
+        responses: {
+            /** @description Successful Response */
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["AxisControlModel"];
+                };
+            };
+            /** @description `not_found`: unknown bus, node, job, object, device, project, axis or motor */
+            404: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `refused_for_safety`: refused to keep the machine safe (no live client, drive enabled) */
+            409: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `invalid_input`: refused before anything was sent or written */
+            422: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `internal`: a bug: logged with the request id */
+            500: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+        };
+    };
+    release_api_buses__bus__nodes__node__control_release_post: {
+        parameters: {
+            query?: {
+                /** @description device key (xtrapulspac, cd1k, …) overriding the identified one; by default the node is identified on first use */
+                device?: string | null;
+            };
+            header?: {
+                /** @description id announced by /api/ws/events; required for motion */
+                "X-Servo-Client"?: string | null;
+            };
+            path: {
+                bus: string;
+                node: number;
+            };
+            cookie?: never;
+        };
+        requestBody?: never;
+        responses: {
+            /** @description Successful Response */
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["AxisControlModel"];
+                };
+            };
+            /** @description `not_found`: unknown bus, node, job, object, device, project, axis or motor */
+            404: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `conflict`: the current state refuses it: a changed project, a taken name, the drive; `refused_for_safety`: refused to keep the machine safe (no live client, drive enabled) */
+            409: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `invalid_input`: refused before anything was sent or written */
+            422: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `internal`: a bug: logged with the request id */
+            500: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `communication`: the drive or the link failed part-way (incomplete backup or restore) */
+            502: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `unavailable`: the bus is not connected, or an axis's drive cannot be reached */
+            503: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `timeout`: the drive did not answer in time */
+            504: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+        };
+    };
+    request_api_buses__bus__nodes__node__control_request_post: {
+        parameters: {
+            query?: never;
+            header?: {
+                /** @description id announced by /api/ws/events; required for motion */
+                "X-Servo-Client"?: string | null;
+            };
+            path: {
+                /** @description node ID */
+                node: number;
+                bus: string;
+            };
+            cookie?: never;
+        };
+        requestBody?: never;
+        responses: {
+            /** @description Successful Response */
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["AxisControlModel"];
+                };
+            };
+            /** @description `not_found`: unknown bus, node, job, object, device, project, axis or motor */
+            404: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `refused_for_safety`: refused to keep the machine safe (no live client, drive enabled) */
+            409: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `invalid_input`: refused before anything was sent or written */
+            422: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `internal`: a bug: logged with the request id */
+            500: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+        };
+    };
+    take_over_api_buses__bus__nodes__node__control_take_over_post: {
+        parameters: {
+            query?: never;
+            header?: {
+                /** @description id announced by /api/ws/events; required for motion */
+                "X-Servo-Client"?: string | null;
+            };
+            path: {
+                /** @description node ID */
+                node: number;
+                bus: string;
+            };
+            cookie?: never;
+        };
+        requestBody?: never;
+        responses: {
+            /** @description Successful Response */
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["AxisControlModel"];
+                };
+            };
+            /** @description `forbidden`: the caller's level is too low, or a foreign page, Host or Origin */
+            403: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `not_found`: unknown bus, node, job, object, device, project, axis or motor */
+            404: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `refused_for_safety`: refused to keep the machine safe (no live client, drive enabled) */
+            409: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `invalid_input`: refused before anything was sent or written */
+            422: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `internal`: a bug: logged with the request id */
+            500: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+        };
+    };
     get_faults_api_buses__bus__nodes__node__faults_get: {
         parameters: {
             query?: {
                 /** @description device key (xtrapulspac, cd1k, …) overriding the identified one; by default the node is identified on first use */
                 device?: string | null;
             };
-            header?: never;
+            header?: {
+                /** @description id announced by /api/ws/events; required for motion */
+                "X-Servo-Client"?: string | null;
+            };
             path: {
                 node: number;
                 bus: string;
@@ -2331,7 +3828,10 @@ export interface operations {
                 /** @description device key (xtrapulspac, cd1k, …) overriding the identified one; by default the node is identified on first use */
                 device?: string | null;
             };
-            header?: never;
+            header?: {
+                /** @description id announced by /api/ws/events; required for motion */
+                "X-Servo-Client"?: string | null;
+            };
             path: {
                 bus: string;
                 node: number;
@@ -2420,7 +3920,10 @@ export interface operations {
                 /** @description device key (xtrapulspac, cd1k, …) overriding the identified one; by default the node is identified on first use */
                 device?: string | null;
             };
-            header?: never;
+            header?: {
+                /** @description id announced by /api/ws/events; required for motion */
+                "X-Servo-Client"?: string | null;
+            };
             path: {
                 name: string;
                 node: number;
@@ -2445,6 +3948,7 @@ export interface operations {
                     [name: string]: unknown;
                 };
                 content: {
+                    "application/json": components["schemas"]["ErrorBody"];
                     "text/plain": components["schemas"]["ErrorBody"];
                 };
             };
@@ -2454,6 +3958,7 @@ export interface operations {
                     [name: string]: unknown;
                 };
                 content: {
+                    "application/json": components["schemas"]["ErrorBody"];
                     "text/plain": components["schemas"]["ErrorBody"];
                 };
             };
@@ -2463,6 +3968,7 @@ export interface operations {
                     [name: string]: unknown;
                 };
                 content: {
+                    "application/json": components["schemas"]["ErrorBody"];
                     "text/plain": components["schemas"]["ErrorBody"];
                 };
             };
@@ -2472,6 +3978,7 @@ export interface operations {
                     [name: string]: unknown;
                 };
                 content: {
+                    "application/json": components["schemas"]["ErrorBody"];
                     "text/plain": components["schemas"]["ErrorBody"];
                 };
             };
@@ -2481,6 +3988,7 @@ export interface operations {
                     [name: string]: unknown;
                 };
                 content: {
+                    "application/json": components["schemas"]["ErrorBody"];
                     "text/plain": components["schemas"]["ErrorBody"];
                 };
             };
@@ -2490,6 +3998,7 @@ export interface operations {
                     [name: string]: unknown;
                 };
                 content: {
+                    "application/json": components["schemas"]["ErrorBody"];
                     "text/plain": components["schemas"]["ErrorBody"];
                 };
             };
@@ -2499,6 +4008,7 @@ export interface operations {
                     [name: string]: unknown;
                 };
                 content: {
+                    "application/json": components["schemas"]["ErrorBody"];
                     "text/plain": components["schemas"]["ErrorBody"];
                 };
             };
@@ -2512,7 +4022,10 @@ export interface operations {
                 /** @description device key (xtrapulspac, cd1k, …) overriding the identified one; by default the node is identified on first use */
                 device?: string | null;
             };
-            header?: never;
+            header?: {
+                /** @description id announced by /api/ws/events; required for motion */
+                "X-Servo-Client"?: string | null;
+            };
             path: {
                 name: string;
                 bus: string;
@@ -2535,6 +4048,15 @@ export interface operations {
                     "application/json": unknown;
                 };
             };
+            /** @description with job=true: the restore job, started */
+            202: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["JobModel"];
+                };
+            };
             /** @description `not_found`: unknown bus, node, job, object, device, project, axis or motor */
             404: {
                 headers: {
@@ -2546,6 +4068,15 @@ export interface operations {
             };
             /** @description `conflict`: the current state refuses it: a changed project, a taken name, the drive; `refused_for_safety`: refused to keep the machine safe (no live client, drive enabled) */
             409: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `too_large`: an upload larger than its limit; nothing was kept */
+            413: {
                 headers: {
                     [name: string]: unknown;
                 };
@@ -2606,7 +4137,10 @@ export interface operations {
                 /** @description device key (xtrapulspac, cd1k, …) overriding the identified one; by default the node is identified on first use */
                 device?: string | null;
             };
-            header?: never;
+            header?: {
+                /** @description id announced by /api/ws/events; required for motion */
+                "X-Servo-Client"?: string | null;
+            };
             path: {
                 key: string;
                 node: number;
@@ -2697,13 +4231,13 @@ export interface operations {
                 device?: string | null;
             };
             header?: {
-                /** @description id announced by /api/ws/events; required to enable */
+                /** @description id announced by /api/ws/events; required for motion */
                 "X-Servo-Client"?: string | null;
             };
             path: {
-                bus: string;
                 key: string;
                 node: number;
+                bus: string;
             };
             cookie?: never;
         };
@@ -2793,7 +4327,10 @@ export interface operations {
                 /** @description device key (xtrapulspac, cd1k, …) overriding the identified one; by default the node is identified on first use */
                 device?: string | null;
             };
-            header?: never;
+            header?: {
+                /** @description id announced by /api/ws/events; required for motion */
+                "X-Servo-Client"?: string | null;
+            };
             path: {
                 node: number;
                 bus: string;
@@ -2880,13 +4417,729 @@ export interface operations {
             };
         };
     };
+    get_scope_api_buses__bus__nodes__node__scope_get: {
+        parameters: {
+            query?: {
+                /** @description device key (xtrapulspac, cd1k, …) overriding the identified one; by default the node is identified on first use */
+                device?: string | null;
+            };
+            header?: {
+                /** @description id announced by /api/ws/events; required for motion */
+                "X-Servo-Client"?: string | null;
+            };
+            path: {
+                node: number;
+                bus: string;
+            };
+            cookie?: never;
+        };
+        requestBody?: never;
+        responses: {
+            /** @description Successful Response */
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ScopeInfo"];
+                };
+            };
+            /** @description `not_found`: unknown bus, node, job, object, device, project, axis or motor */
+            404: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `conflict`: the current state refuses it: a changed project, a taken name, the drive; `refused_for_safety`: refused to keep the machine safe (no live client, drive enabled) */
+            409: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `invalid_input`: refused before anything was sent or written */
+            422: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `internal`: a bug: logged with the request id */
+            500: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `communication`: the drive or the link failed part-way (incomplete backup or restore) */
+            502: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `unavailable`: the bus is not connected, or an axis's drive cannot be reached */
+            503: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `timeout`: the drive did not answer in time */
+            504: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+        };
+    };
+    start_capture_api_buses__bus__nodes__node__scope_captures_post: {
+        parameters: {
+            query?: {
+                /** @description device key (xtrapulspac, cd1k, …) overriding the identified one; by default the node is identified on first use */
+                device?: string | null;
+            };
+            header?: {
+                /** @description id announced by /api/ws/events; required for motion */
+                "X-Servo-Client"?: string | null;
+            };
+            path: {
+                bus: string;
+                node: number;
+            };
+            cookie?: never;
+        };
+        requestBody: {
+            content: {
+                "application/json": components["schemas"]["CaptureRequest"];
+            };
+        };
+        responses: {
+            /** @description Successful Response */
+            202: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["JobModel"];
+                };
+            };
+            /** @description `not_found`: unknown bus, node, job, object, device, project, axis or motor */
+            404: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `conflict`: the current state refuses it: a changed project, a taken name, the drive; `refused_for_safety`: refused to keep the machine safe (no live client, drive enabled) */
+            409: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `invalid_input`: refused before anything was sent or written */
+            422: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `internal`: a bug: logged with the request id */
+            500: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `communication`: the drive or the link failed part-way (incomplete backup or restore) */
+            502: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `unavailable`: the bus is not connected, or an axis's drive cannot be reached */
+            503: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `timeout`: the drive did not answer in time */
+            504: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+        };
+    };
+    get_capture_api_buses__bus__nodes__node__scope_captures__capture_id__get: {
+        parameters: {
+            query?: never;
+            header?: never;
+            path: {
+                bus: string;
+                node: number;
+                capture_id: string;
+            };
+            cookie?: never;
+        };
+        requestBody?: never;
+        responses: {
+            /** @description Successful Response */
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["CaptureModel"];
+                };
+            };
+            /** @description `not_found`: unknown bus, node, job, object, device, project, axis or motor */
+            404: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `invalid_input`: refused before anything was sent or written */
+            422: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `internal`: a bug: logged with the request id */
+            500: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+        };
+    };
+    get_capture_csv_api_buses__bus__nodes__node__scope_captures__capture_id__csv_get: {
+        parameters: {
+            query?: never;
+            header?: never;
+            path: {
+                bus: string;
+                node: number;
+                capture_id: string;
+            };
+            cookie?: never;
+        };
+        requestBody?: never;
+        responses: {
+            /** @description Successful Response */
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "text/csv": unknown;
+                };
+            };
+            /** @description `not_found`: unknown bus, node, job, object, device, project, axis or motor */
+            404: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `invalid_input`: refused before anything was sent or written */
+            422: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `internal`: a bug: logged with the request id */
+            500: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+        };
+    };
+    get_capture_html_api_buses__bus__nodes__node__scope_captures__capture_id__html_get: {
+        parameters: {
+            query?: never;
+            header?: never;
+            path: {
+                bus: string;
+                node: number;
+                capture_id: string;
+            };
+            cookie?: never;
+        };
+        requestBody?: never;
+        responses: {
+            /** @description Successful Response */
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "text/html": unknown;
+                };
+            };
+            /** @description `not_found`: unknown bus, node, job, object, device, project, axis or motor */
+            404: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `invalid_input`: refused before anything was sent or written */
+            422: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `internal`: a bug: logged with the request id */
+            500: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+        };
+    };
+    check_capture_api_buses__bus__nodes__node__scope_check_post: {
+        parameters: {
+            query?: {
+                /** @description device key (xtrapulspac, cd1k, …) overriding the identified one; by default the node is identified on first use */
+                device?: string | null;
+            };
+            header?: {
+                /** @description id announced by /api/ws/events; required for motion */
+                "X-Servo-Client"?: string | null;
+            };
+            path: {
+                node: number;
+                bus: string;
+            };
+            cookie?: never;
+        };
+        requestBody: {
+            content: {
+                "application/json": components["schemas"]["CaptureRequest"];
+            };
+        };
+        responses: {
+            /** @description Successful Response */
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["PlanModel"];
+                };
+            };
+            /** @description `not_found`: unknown bus, node, job, object, device, project, axis or motor */
+            404: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `conflict`: the current state refuses it: a changed project, a taken name, the drive; `refused_for_safety`: refused to keep the machine safe (no live client, drive enabled) */
+            409: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `invalid_input`: refused before anything was sent or written */
+            422: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `internal`: a bug: logged with the request id */
+            500: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `communication`: the drive or the link failed part-way (incomplete backup or restore) */
+            502: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `unavailable`: the bus is not connected, or an axis's drive cannot be reached */
+            503: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `timeout`: the drive did not answer in time */
+            504: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+        };
+    };
+    force_trigger_api_buses__bus__nodes__node__scope_force_post: {
+        parameters: {
+            query?: {
+                /** @description device key (xtrapulspac, cd1k, …) overriding the identified one; by default the node is identified on first use */
+                device?: string | null;
+            };
+            header?: {
+                /** @description id announced by /api/ws/events; required for motion */
+                "X-Servo-Client"?: string | null;
+            };
+            path: {
+                bus: string;
+                node: number;
+            };
+            cookie?: never;
+        };
+        requestBody?: never;
+        responses: {
+            /** @description Successful Response */
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["RecorderStatus"];
+                };
+            };
+            /** @description `not_found`: unknown bus, node, job, object, device, project, axis or motor */
+            404: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `conflict`: the current state refuses it: a changed project, a taken name, the drive; `refused_for_safety`: refused to keep the machine safe (no live client, drive enabled) */
+            409: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `invalid_input`: refused before anything was sent or written */
+            422: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `internal`: a bug: logged with the request id */
+            500: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `communication`: the drive or the link failed part-way (incomplete backup or restore) */
+            502: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `unavailable`: the bus is not connected, or an axis's drive cannot be reached */
+            503: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `timeout`: the drive did not answer in time */
+            504: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+        };
+    };
+    get_status_api_buses__bus__nodes__node__scope_status_get: {
+        parameters: {
+            query?: {
+                /** @description device key (xtrapulspac, cd1k, …) overriding the identified one; by default the node is identified on first use */
+                device?: string | null;
+            };
+            header?: {
+                /** @description id announced by /api/ws/events; required for motion */
+                "X-Servo-Client"?: string | null;
+            };
+            path: {
+                bus: string;
+                node: number;
+            };
+            cookie?: never;
+        };
+        requestBody?: never;
+        responses: {
+            /** @description Successful Response */
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["RecorderStatus"];
+                };
+            };
+            /** @description `not_found`: unknown bus, node, job, object, device, project, axis or motor */
+            404: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `conflict`: the current state refuses it: a changed project, a taken name, the drive; `refused_for_safety`: refused to keep the machine safe (no live client, drive enabled) */
+            409: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `invalid_input`: refused before anything was sent or written */
+            422: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `internal`: a bug: logged with the request id */
+            500: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `communication`: the drive or the link failed part-way (incomplete backup or restore) */
+            502: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `unavailable`: the bus is not connected, or an axis's drive cannot be reached */
+            503: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `timeout`: the drive did not answer in time */
+            504: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+        };
+    };
+    stop_capture_api_buses__bus__nodes__node__scope_stop_post: {
+        parameters: {
+            query?: {
+                /** @description device key (xtrapulspac, cd1k, …) overriding the identified one; by default the node is identified on first use */
+                device?: string | null;
+            };
+            header?: {
+                /** @description id announced by /api/ws/events; required for motion */
+                "X-Servo-Client"?: string | null;
+            };
+            path: {
+                bus: string;
+                node: number;
+            };
+            cookie?: never;
+        };
+        requestBody?: never;
+        responses: {
+            /** @description Successful Response */
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["RecorderStatus"];
+                };
+            };
+            /** @description `not_found`: unknown bus, node, job, object, device, project, axis or motor */
+            404: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `conflict`: the current state refuses it: a changed project, a taken name, the drive; `refused_for_safety`: refused to keep the machine safe (no live client, drive enabled) */
+            409: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `invalid_input`: refused before anything was sent or written */
+            422: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `internal`: a bug: logged with the request id */
+            500: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `communication`: the drive or the link failed part-way (incomplete backup or restore) */
+            502: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `unavailable`: the bus is not connected, or an axis's drive cannot be reached */
+            503: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `timeout`: the drive did not answer in time */
+            504: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+        };
+    };
     get_state_api_buses__bus__nodes__node__state_get: {
         parameters: {
             query?: {
                 /** @description device key (xtrapulspac, cd1k, …) overriding the identified one; by default the node is identified on first use */
                 device?: string | null;
             };
-            header?: never;
+            header?: {
+                /** @description id announced by /api/ws/events; required for motion */
+                "X-Servo-Client"?: string | null;
+            };
             path: {
                 bus: string;
                 node: number;
@@ -2976,7 +5229,7 @@ export interface operations {
                 device?: string | null;
             };
             header?: {
-                /** @description id announced by /api/ws/events; required to enable */
+                /** @description id announced by /api/ws/events; required for motion */
                 "X-Servo-Client"?: string | null;
             };
             path: {
@@ -3068,7 +5321,10 @@ export interface operations {
     start_restore_api_buses__bus__restore_post: {
         parameters: {
             query?: never;
-            header?: never;
+            header?: {
+                /** @description id announced by /api/ws/events; required for motion */
+                "X-Servo-Client"?: string | null;
+            };
             path: {
                 bus: string;
             };
@@ -3121,7 +5377,10 @@ export interface operations {
     scan_bus_api_buses__bus__scan_post: {
         parameters: {
             query?: never;
-            header?: never;
+            header?: {
+                /** @description id announced by /api/ws/events; required for motion */
+                "X-Servo-Client"?: string | null;
+            };
             path: {
                 bus: string;
             };
@@ -3132,6 +5391,8 @@ export interface operations {
             /** @description Successful Response */
             200: {
                 headers: {
+                    /** @description set when the scan found no node: why the bus may look empty (bit rate, termination, power, channel) */
+                    "X-Scan-Hint"?: string;
                     [name: string]: unknown;
                 };
                 content: {
@@ -3176,6 +5437,62 @@ export interface operations {
             };
             /** @description `unavailable`: the bus is not connected, or an axis's drive cannot be reached */
             503: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+        };
+    };
+    list_controls_api_control_get: {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        requestBody?: never;
+        responses: {
+            /** @description Successful Response */
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["AxisControlModel"][];
+                };
+            };
+            /** @description `not_found`: unknown bus, node, job, object, device, project, axis or motor */
+            404: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `conflict`: the current state refuses it: a changed project, a taken name, the drive */
+            409: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `invalid_input`: refused before anything was sent or written */
+            422: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `internal`: a bug: logged with the request id */
+            500: {
                 headers: {
                     [name: string]: unknown;
                 };
@@ -3301,6 +5618,15 @@ export interface operations {
                 };
                 content: {
                     "application/json": components["schemas"]["DictionarySummary"];
+                };
+            };
+            /** @description `too_large`: an upload larger than its limit; nothing was kept */
+            413: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
                 };
             };
             /** @description `invalid_input`: refused before anything was sent or written */
@@ -3564,6 +5890,100 @@ export interface operations {
                     "application/json": components["schemas"]["UserModel"];
                 };
             };
+            /** @description `unauthenticated`: no valid session or token (log in, or pass a live API token) */
+            401: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `forbidden`: the caller's level is too low, or a foreign page, Host or Origin */
+            403: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `not_found`: unknown bus, node, job, object, device, project, axis or motor */
+            404: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `invalid_input`: refused before anything was sent or written */
+            422: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `internal`: a bug: logged with the request id */
+            500: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+        };
+    };
+    change_password_api_me_password_put: {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        requestBody: {
+            content: {
+                "application/json": components["schemas"]["PasswordChange"];
+            };
+        };
+        responses: {
+            /** @description Successful Response */
+            204: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content?: never;
+            };
+            /** @description `unauthenticated`: no valid session or token (log in, or pass a live API token) */
+            401: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `forbidden`: the caller's level is too low, or a foreign page, Host or Origin */
+            403: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `not_found`: unknown bus, node, job, object, device, project, axis or motor */
+            404: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
             /** @description `invalid_input`: refused before anything was sent or written */
             422: {
                 headers: {
@@ -3587,7 +6007,10 @@ export interface operations {
     list_motors_api_motors_get: {
         parameters: {
             query?: never;
-            header?: never;
+            header?: {
+                /** @description id announced by /api/ws/events; required for motion */
+                "X-Servo-Client"?: string | null;
+            };
             path?: never;
             cookie?: never;
         };
@@ -3643,7 +6066,10 @@ export interface operations {
     add_motor_api_motors_post: {
         parameters: {
             query?: never;
-            header?: never;
+            header?: {
+                /** @description id announced by /api/ws/events; required for motion */
+                "X-Servo-Client"?: string | null;
+            };
             path?: never;
             cookie?: never;
         };
@@ -3703,7 +6129,10 @@ export interface operations {
     remove_motor_api_motors__reference__delete: {
         parameters: {
             query?: never;
-            header?: never;
+            header?: {
+                /** @description id announced by /api/ws/events; required for motion */
+                "X-Servo-Client"?: string | null;
+            };
             path: {
                 reference: string;
             };
@@ -3759,7 +6188,10 @@ export interface operations {
     list_projects_api_projects_get: {
         parameters: {
             query?: never;
-            header?: never;
+            header?: {
+                /** @description id announced by /api/ws/events; required for motion */
+                "X-Servo-Client"?: string | null;
+            };
             path?: never;
             cookie?: never;
         };
@@ -3815,7 +6247,10 @@ export interface operations {
     create_project_api_projects_post: {
         parameters: {
             query?: never;
-            header?: never;
+            header?: {
+                /** @description id announced by /api/ws/events; required for motion */
+                "X-Servo-Client"?: string | null;
+            };
             path?: never;
             cookie?: never;
         };
@@ -3877,7 +6312,10 @@ export interface operations {
             query?: {
                 new_name?: string | null;
             };
-            header?: never;
+            header?: {
+                /** @description id announced by /api/ws/events; required for motion */
+                "X-Servo-Client"?: string | null;
+            };
             path?: never;
             cookie?: never;
         };
@@ -3942,7 +6380,10 @@ export interface operations {
     get_project_api_projects__name__get: {
         parameters: {
             query?: never;
-            header?: never;
+            header?: {
+                /** @description id announced by /api/ws/events; required for motion */
+                "X-Servo-Client"?: string | null;
+            };
             path: {
                 name: string;
             };
@@ -4002,7 +6443,10 @@ export interface operations {
             query?: {
                 revision?: string | null;
             };
-            header?: never;
+            header?: {
+                /** @description id announced by /api/ws/events; required for motion */
+                "X-Servo-Client"?: string | null;
+            };
             path: {
                 name: string;
             };
@@ -4058,7 +6502,10 @@ export interface operations {
     update_project_api_projects__name__patch: {
         parameters: {
             query?: never;
-            header?: never;
+            header?: {
+                /** @description id announced by /api/ws/events; required for motion */
+                "X-Servo-Client"?: string | null;
+            };
             path: {
                 name: string;
             };
@@ -4120,7 +6567,10 @@ export interface operations {
     archive_project_api_projects__name__archive_get: {
         parameters: {
             query?: never;
-            header?: never;
+            header?: {
+                /** @description id announced by /api/ws/events; required for motion */
+                "X-Servo-Client"?: string | null;
+            };
             path: {
                 name: string;
             };
@@ -4176,7 +6626,10 @@ export interface operations {
     add_axis_api_projects__name__axes_post: {
         parameters: {
             query?: never;
-            header?: never;
+            header?: {
+                /** @description id announced by /api/ws/events; required for motion */
+                "X-Servo-Client"?: string | null;
+            };
             path: {
                 name: string;
             };
@@ -4240,7 +6693,10 @@ export interface operations {
             query?: {
                 revision?: string | null;
             };
-            header?: never;
+            header?: {
+                /** @description id announced by /api/ws/events; required for motion */
+                "X-Servo-Client"?: string | null;
+            };
             path: {
                 name: string;
                 axis: string;
@@ -4299,7 +6755,10 @@ export interface operations {
     edit_axis_api_projects__name__axes__axis__patch: {
         parameters: {
             query?: never;
-            header?: never;
+            header?: {
+                /** @description id announced by /api/ws/events; required for motion */
+                "X-Servo-Client"?: string | null;
+            };
             path: {
                 name: string;
                 axis: string;
@@ -4362,7 +6821,10 @@ export interface operations {
     get_application_api_projects__name__axes__axis__application_get: {
         parameters: {
             query?: never;
-            header?: never;
+            header?: {
+                /** @description id announced by /api/ws/events; required for motion */
+                "X-Servo-Client"?: string | null;
+            };
             path: {
                 name: string;
                 axis: string;
@@ -4421,7 +6883,10 @@ export interface operations {
     apply_application_api_projects__name__axes__axis__application_post: {
         parameters: {
             query?: never;
-            header?: never;
+            header?: {
+                /** @description id announced by /api/ws/events; required for motion */
+                "X-Servo-Client"?: string | null;
+            };
             path: {
                 name: string;
                 axis: string;
@@ -4488,7 +6953,10 @@ export interface operations {
                 only_differences?: boolean;
                 drive?: boolean;
             };
-            header?: never;
+            header?: {
+                /** @description id announced by /api/ws/events; required for motion */
+                "X-Servo-Client"?: string | null;
+            };
             path: {
                 name: string;
                 axis: string;
@@ -4574,7 +7042,10 @@ export interface operations {
     export_dcf_api_projects__name__axes__axis__dcf_get: {
         parameters: {
             query?: never;
-            header?: never;
+            header?: {
+                /** @description id announced by /api/ws/events; required for motion */
+                "X-Servo-Client"?: string | null;
+            };
             path: {
                 name: string;
                 axis: string;
@@ -4633,7 +7104,10 @@ export interface operations {
     select_motor_api_projects__name__axes__axis__motor_post: {
         parameters: {
             query?: never;
-            header?: never;
+            header?: {
+                /** @description id announced by /api/ws/events; required for motion */
+                "X-Servo-Client"?: string | null;
+            };
             path: {
                 name: string;
                 axis: string;
@@ -4728,7 +7202,10 @@ export interface operations {
                 only_differences?: boolean;
                 include_unsaved?: boolean;
             };
-            header?: never;
+            header?: {
+                /** @description id announced by /api/ws/events; required for motion */
+                "X-Servo-Client"?: string | null;
+            };
             path: {
                 name: string;
                 axis: string;
@@ -4787,7 +7264,10 @@ export interface operations {
     set_parameters_api_projects__name__axes__axis__parameters_put: {
         parameters: {
             query?: never;
-            header?: never;
+            header?: {
+                /** @description id announced by /api/ws/events; required for motion */
+                "X-Servo-Client"?: string | null;
+            };
             path: {
                 name: string;
                 axis: string;
@@ -4850,7 +7330,10 @@ export interface operations {
     reset_parameters_api_projects__name__axes__axis__parameters_reset_post: {
         parameters: {
             query?: never;
-            header?: never;
+            header?: {
+                /** @description id announced by /api/ws/events; required for motion */
+                "X-Servo-Client"?: string | null;
+            };
             path: {
                 name: string;
                 axis: string;
@@ -4913,7 +7396,10 @@ export interface operations {
     get_parameter_api_projects__name__axes__axis__parameters__address__get: {
         parameters: {
             query?: never;
-            header?: never;
+            header?: {
+                /** @description id announced by /api/ws/events; required for motion */
+                "X-Servo-Client"?: string | null;
+            };
             path: {
                 name: string;
                 axis: string;
@@ -4973,7 +7459,10 @@ export interface operations {
     take_from_drive_api_projects__name__axes__axis__take_from_drive_post: {
         parameters: {
             query?: never;
-            header?: never;
+            header?: {
+                /** @description id announced by /api/ws/events; required for motion */
+                "X-Servo-Client"?: string | null;
+            };
             path: {
                 name: string;
                 axis: string;
@@ -5063,7 +7552,10 @@ export interface operations {
     write_to_drive_api_projects__name__axes__axis__write_to_drive_post: {
         parameters: {
             query?: never;
-            header?: never;
+            header?: {
+                /** @description id announced by /api/ws/events; required for motion */
+                "X-Servo-Client"?: string | null;
+            };
             path: {
                 name: string;
                 axis: string;
@@ -5153,7 +7645,10 @@ export interface operations {
     start_commission_api_projects__name__commission_post: {
         parameters: {
             query?: never;
-            header?: never;
+            header?: {
+                /** @description id announced by /api/ws/events; required for motion */
+                "X-Servo-Client"?: string | null;
+            };
             path: {
                 name: string;
             };
@@ -5242,7 +7737,10 @@ export interface operations {
     duplicate_project_api_projects__name__duplicate_post: {
         parameters: {
             query?: never;
-            header?: never;
+            header?: {
+                /** @description id announced by /api/ws/events; required for motion */
+                "X-Servo-Client"?: string | null;
+            };
             path: {
                 name: string;
             };
@@ -5304,7 +7802,10 @@ export interface operations {
     rename_project_api_projects__name__rename_post: {
         parameters: {
             query?: never;
-            header?: never;
+            header?: {
+                /** @description id announced by /api/ws/events; required for motion */
+                "X-Servo-Client"?: string | null;
+            };
             path: {
                 name: string;
             };
@@ -5366,7 +7867,10 @@ export interface operations {
     scan_into_project_api_projects__name__scan_post: {
         parameters: {
             query?: never;
-            header?: never;
+            header?: {
+                /** @description id announced by /api/ws/events; required for motion */
+                "X-Servo-Client"?: string | null;
+            };
             path: {
                 name: string;
             };
@@ -5443,6 +7947,1155 @@ export interface operations {
             };
             /** @description `timeout`: the drive did not answer in time */
             504: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+        };
+    };
+    list_saved_api_projects__project__axes__axis__captures_get: {
+        parameters: {
+            query?: never;
+            header?: {
+                /** @description id announced by /api/ws/events; required for motion */
+                "X-Servo-Client"?: string | null;
+            };
+            path: {
+                project: string;
+                axis: string;
+            };
+            cookie?: never;
+        };
+        requestBody?: never;
+        responses: {
+            /** @description Successful Response */
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["SavedCaptureModel"][];
+                };
+            };
+            /** @description `not_found`: unknown bus, node, job, object, device, project, axis or motor */
+            404: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `conflict`: the current state refuses it: a changed project, a taken name, the drive */
+            409: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `invalid_input`: refused before anything was sent or written */
+            422: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `internal`: a bug: logged with the request id */
+            500: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+        };
+    };
+    save_capture_api_projects__project__axes__axis__captures_post: {
+        parameters: {
+            query?: never;
+            header?: {
+                /** @description id announced by /api/ws/events; required for motion */
+                "X-Servo-Client"?: string | null;
+            };
+            path: {
+                project: string;
+                axis: string;
+            };
+            cookie?: never;
+        };
+        requestBody: {
+            content: {
+                "application/json": components["schemas"]["SaveRequest"];
+            };
+        };
+        responses: {
+            /** @description Successful Response */
+            201: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["CaptureModel"];
+                };
+            };
+            /** @description `not_found`: unknown bus, node, job, object, device, project, axis or motor */
+            404: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `conflict`: the current state refuses it: a changed project, a taken name, the drive */
+            409: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `invalid_input`: refused before anything was sent or written */
+            422: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `internal`: a bug: logged with the request id */
+            500: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+        };
+    };
+    open_saved_api_projects__project__axes__axis__captures__name__get: {
+        parameters: {
+            query?: never;
+            header?: {
+                /** @description id announced by /api/ws/events; required for motion */
+                "X-Servo-Client"?: string | null;
+            };
+            path: {
+                project: string;
+                axis: string;
+                name: string;
+            };
+            cookie?: never;
+        };
+        requestBody?: never;
+        responses: {
+            /** @description Successful Response */
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["CaptureModel"];
+                };
+            };
+            /** @description `not_found`: unknown bus, node, job, object, device, project, axis or motor */
+            404: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `conflict`: the current state refuses it: a changed project, a taken name, the drive */
+            409: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `invalid_input`: refused before anything was sent or written */
+            422: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `internal`: a bug: logged with the request id */
+            500: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+        };
+    };
+    delete_saved_api_projects__project__axes__axis__captures__name__delete: {
+        parameters: {
+            query?: never;
+            header?: {
+                /** @description id announced by /api/ws/events; required for motion */
+                "X-Servo-Client"?: string | null;
+            };
+            path: {
+                project: string;
+                axis: string;
+                name: string;
+            };
+            cookie?: never;
+        };
+        requestBody?: never;
+        responses: {
+            /** @description Successful Response */
+            204: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content?: never;
+            };
+            /** @description `not_found`: unknown bus, node, job, object, device, project, axis or motor */
+            404: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `conflict`: the current state refuses it: a changed project, a taken name, the drive */
+            409: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `invalid_input`: refused before anything was sent or written */
+            422: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `internal`: a bug: logged with the request id */
+            500: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+        };
+    };
+    saved_csv_api_projects__project__axes__axis__captures__name__csv_get: {
+        parameters: {
+            query?: never;
+            header?: {
+                /** @description id announced by /api/ws/events; required for motion */
+                "X-Servo-Client"?: string | null;
+            };
+            path: {
+                project: string;
+                axis: string;
+                name: string;
+            };
+            cookie?: never;
+        };
+        requestBody?: never;
+        responses: {
+            /** @description Successful Response */
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "text/csv": unknown;
+                };
+            };
+            /** @description `not_found`: unknown bus, node, job, object, device, project, axis or motor */
+            404: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `conflict`: the current state refuses it: a changed project, a taken name, the drive */
+            409: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `invalid_input`: refused before anything was sent or written */
+            422: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `internal`: a bug: logged with the request id */
+            500: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+        };
+    };
+    saved_html_api_projects__project__axes__axis__captures__name__html_get: {
+        parameters: {
+            query?: never;
+            header?: {
+                /** @description id announced by /api/ws/events; required for motion */
+                "X-Servo-Client"?: string | null;
+            };
+            path: {
+                project: string;
+                axis: string;
+                name: string;
+            };
+            cookie?: never;
+        };
+        requestBody?: never;
+        responses: {
+            /** @description Successful Response */
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "text/html": unknown;
+                };
+            };
+            /** @description `not_found`: unknown bus, node, job, object, device, project, axis or motor */
+            404: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `conflict`: the current state refuses it: a changed project, a taken name, the drive */
+            409: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `invalid_input`: refused before anything was sent or written */
+            422: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `internal`: a bug: logged with the request id */
+            500: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+        };
+    };
+    log_in_api_session_post: {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        requestBody: {
+            content: {
+                "application/json": components["schemas"]["Login"];
+            };
+        };
+        responses: {
+            /** @description Successful Response */
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["UserModel"];
+                };
+            };
+            /** @description `unauthenticated`: no valid session or token (log in, or pass a live API token) */
+            401: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `forbidden`: the caller's level is too low, or a foreign page, Host or Origin */
+            403: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `not_found`: unknown bus, node, job, object, device, project, axis or motor */
+            404: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `conflict`: the current state refuses it: a changed project, a taken name, the drive */
+            409: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `invalid_input`: refused before anything was sent or written */
+            422: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `rate_limited`: too many failed logins from this user or address; wait and retry */
+            429: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `internal`: a bug: logged with the request id */
+            500: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+        };
+    };
+    log_out_api_session_delete: {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        requestBody?: never;
+        responses: {
+            /** @description Successful Response */
+            204: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content?: never;
+            };
+            /** @description `unauthenticated`: no valid session or token (log in, or pass a live API token) */
+            401: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `forbidden`: the caller's level is too low, or a foreign page, Host or Origin */
+            403: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `not_found`: unknown bus, node, job, object, device, project, axis or motor */
+            404: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `invalid_input`: refused before anything was sent or written */
+            422: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `internal`: a bug: logged with the request id */
+            500: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+        };
+    };
+    get_setup_api_setup_get: {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        requestBody?: never;
+        responses: {
+            /** @description Successful Response */
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["SetupStatus"];
+                };
+            };
+            /** @description `unauthenticated`: no valid session or token (log in, or pass a live API token) */
+            401: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `forbidden`: the caller's level is too low, or a foreign page, Host or Origin */
+            403: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `not_found`: unknown bus, node, job, object, device, project, axis or motor */
+            404: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `invalid_input`: refused before anything was sent or written */
+            422: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `internal`: a bug: logged with the request id */
+            500: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+        };
+    };
+    post_setup_api_setup_post: {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        requestBody: {
+            content: {
+                "application/json": components["schemas"]["SetupRequest"];
+            };
+        };
+        responses: {
+            /** @description Successful Response */
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["UserModel"] | null;
+                };
+            };
+            /** @description `unauthenticated`: no valid session or token (log in, or pass a live API token) */
+            401: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `forbidden`: the caller's level is too low, or a foreign page, Host or Origin */
+            403: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `not_found`: unknown bus, node, job, object, device, project, axis or motor */
+            404: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `conflict`: the current state refuses it: a changed project, a taken name, the drive */
+            409: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `invalid_input`: refused before anything was sent or written */
+            422: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `rate_limited`: too many failed logins from this user or address; wait and retry */
+            429: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `internal`: a bug: logged with the request id */
+            500: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+        };
+    };
+    list_tokens_api_tokens_get: {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        requestBody?: never;
+        responses: {
+            /** @description Successful Response */
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["TokenModel"][];
+                };
+            };
+            /** @description `unauthenticated`: no valid session or token (log in, or pass a live API token) */
+            401: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `forbidden`: the caller's level is too low, or a foreign page, Host or Origin */
+            403: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `not_found`: unknown bus, node, job, object, device, project, axis or motor */
+            404: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `invalid_input`: refused before anything was sent or written */
+            422: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `internal`: a bug: logged with the request id */
+            500: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+        };
+    };
+    create_token_api_tokens_post: {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        requestBody: {
+            content: {
+                "application/json": components["schemas"]["TokenRequest"];
+            };
+        };
+        responses: {
+            /** @description Successful Response */
+            201: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["NewToken"];
+                };
+            };
+            /** @description `unauthenticated`: no valid session or token (log in, or pass a live API token) */
+            401: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `forbidden`: the caller's level is too low, or a foreign page, Host or Origin */
+            403: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `not_found`: unknown bus, node, job, object, device, project, axis or motor */
+            404: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `invalid_input`: refused before anything was sent or written */
+            422: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `internal`: a bug: logged with the request id */
+            500: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+        };
+    };
+    revoke_token_api_tokens__token_id__delete: {
+        parameters: {
+            query?: never;
+            header?: never;
+            path: {
+                token_id: string;
+            };
+            cookie?: never;
+        };
+        requestBody?: never;
+        responses: {
+            /** @description Successful Response */
+            204: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content?: never;
+            };
+            /** @description `unauthenticated`: no valid session or token (log in, or pass a live API token) */
+            401: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `forbidden`: the caller's level is too low, or a foreign page, Host or Origin */
+            403: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `not_found`: unknown bus, node, job, object, device, project, axis or motor */
+            404: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `invalid_input`: refused before anything was sent or written */
+            422: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `internal`: a bug: logged with the request id */
+            500: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+        };
+    };
+    list_users_api_users_get: {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        requestBody?: never;
+        responses: {
+            /** @description Successful Response */
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["AccountModel"][];
+                };
+            };
+            /** @description `unauthenticated`: no valid session or token (log in, or pass a live API token) */
+            401: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `forbidden`: the caller's level is too low, or a foreign page, Host or Origin */
+            403: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `not_found`: unknown bus, node, job, object, device, project, axis or motor */
+            404: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `invalid_input`: refused before anything was sent or written */
+            422: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `internal`: a bug: logged with the request id */
+            500: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+        };
+    };
+    add_user_api_users_post: {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        requestBody: {
+            content: {
+                "application/json": components["schemas"]["NewUser"];
+            };
+        };
+        responses: {
+            /** @description Successful Response */
+            201: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["AccountModel"];
+                };
+            };
+            /** @description `unauthenticated`: no valid session or token (log in, or pass a live API token) */
+            401: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `forbidden`: the caller's level is too low, or a foreign page, Host or Origin */
+            403: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `not_found`: unknown bus, node, job, object, device, project, axis or motor */
+            404: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `invalid_input`: refused before anything was sent or written */
+            422: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `internal`: a bug: logged with the request id */
+            500: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+        };
+    };
+    remove_user_api_users__name__delete: {
+        parameters: {
+            query?: never;
+            header?: never;
+            path: {
+                name: string;
+            };
+            cookie?: never;
+        };
+        requestBody?: never;
+        responses: {
+            /** @description Successful Response */
+            204: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content?: never;
+            };
+            /** @description `unauthenticated`: no valid session or token (log in, or pass a live API token) */
+            401: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `forbidden`: the caller's level is too low, or a foreign page, Host or Origin */
+            403: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `not_found`: unknown bus, node, job, object, device, project, axis or motor */
+            404: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `invalid_input`: refused before anything was sent or written */
+            422: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `internal`: a bug: logged with the request id */
+            500: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+        };
+    };
+    change_user_api_users__name__patch: {
+        parameters: {
+            query?: never;
+            header?: never;
+            path: {
+                name: string;
+            };
+            cookie?: never;
+        };
+        requestBody: {
+            content: {
+                "application/json": components["schemas"]["UserChange"];
+            };
+        };
+        responses: {
+            /** @description Successful Response */
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["AccountModel"];
+                };
+            };
+            /** @description `unauthenticated`: no valid session or token (log in, or pass a live API token) */
+            401: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `forbidden`: the caller's level is too low, or a foreign page, Host or Origin */
+            403: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `not_found`: unknown bus, node, job, object, device, project, axis or motor */
+            404: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `invalid_input`: refused before anything was sent or written */
+            422: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `internal`: a bug: logged with the request id */
+            500: {
                 headers: {
                     [name: string]: unknown;
                 };

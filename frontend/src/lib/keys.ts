@@ -17,6 +17,7 @@ export const BINDINGS: Binding[] = [
   { keys: "g p", action: "go-parameters", description: "Parameters of the current axis" },
   { keys: "g c", action: "go-commissioning", description: "Commissioning checklist of the current axis" },
   { keys: "g k", action: "go-backup", description: "Backup / restore of the current axis" },
+  { keys: "g s", action: "go-scope", description: "Scope of the current axis" },
   { keys: "g b", action: "go-bus", description: "Bus: connect and scan" },
   { keys: "g t", action: "go-terminal", description: "Dialog terminal" },
   { keys: "g o", action: "go-dictionaries", description: "Object dictionaries" },
@@ -24,6 +25,9 @@ export const BINDINGS: Binding[] = [
   { keys: "[", action: "previous-axis", description: "Previous axis of the project" },
   { keys: "]", action: "next-axis", description: "Next axis of the project" },
   { keys: "T", action: "toggle-theme", description: "Switch between light and dark theme" },
+  { keys: "a", action: "scope-arm", description: "Scope: arm the recorder" },
+  { keys: "f", action: "scope-force", description: "Scope: force the trigger" },
+  { keys: "s", action: "scope-stop", description: "Scope: stop the recorder" },
   { keys: "Escape", action: "escape", description: "Close a dialog or this list; leave a field" },
 ];
 

@@ -101,3 +101,16 @@ export function hexWidth(dataType: string): number {
   const match = /(\d+)$/.exec(dataType);
   return match ? Math.max(2, Number(match[1]) / 4) : 8;
 }
+
+/**
+ * The dictionary as one node sees it: a default (or a DCF's configured value) written as `$NODEID+offset` becomes
+ * that node's number. The server keeps the expression, since a dictionary is shared by every node of its device.
+ */
+export function forNode(dictionary: Dictionary, node: number): Dictionary {
+  const resolve = (variable: OdVariable): OdVariable => ({
+    ...variable,
+    default: variable.default_node_offset != null ? node + variable.default_node_offset : variable.default,
+    configured: variable.configured_node_offset != null ? node + variable.configured_node_offset : variable.configured,
+  });
+  return { ...dictionary, objects: dictionary.objects.map((object) => ({ ...object, subs: object.subs.map(resolve) })) };
+}

@@ -3,7 +3,7 @@
  * with index.html, and this module turns the path back into the page to show.
  */
 
-export const AXIS_VIEWS = ["dashboard", "parameters", "commissioning", "backup"] as const;
+export const AXIS_VIEWS = ["dashboard", "parameters", "commissioning", "backup", "scope"] as const;
 export type AxisView = (typeof AXIS_VIEWS)[number];
 
 export type Route =
@@ -16,6 +16,9 @@ export type Route =
   | { page: "dictionaries" }
   | { page: "dictionary"; device: string }
   | { page: "motors" }
+  | { page: "audit" }
+  | { page: "login" }
+  | { page: "setup" }
   | { page: "not-found"; path: string };
 
 /** Route plus its query parameters (`?q=KPv&group=Servo%20Loops` on the parameter pages). */
@@ -42,7 +45,8 @@ function matchParts(parts: string[], pathname: string): Route {
     }
   }
   if (parts.length === 1 && first === "projects") return { page: "home" };
-  if (parts.length === 1 && (first === "bus" || first === "terminal" || first === "motors" || first === "dictionaries")) {
+  if (parts.length === 1 && (first === "login" || first === "setup")) return { page: first };
+  if (parts.length === 1 && (first === "bus" || first === "terminal" || first === "motors" || first === "dictionaries" || first === "audit")) {
     return { page: first };
   }
   if (parts.length === 2 && first === "dictionaries") return { page: "dictionary", device: second };

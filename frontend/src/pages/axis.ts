@@ -3,7 +3,7 @@
 import type { Page, PageContext } from "../app";
 import { getDictionary, projects, type AxisConfig, type Project } from "../client/api";
 import { h, Scope } from "../lib/dom";
-import type { Dictionary } from "../lib/od";
+import { forNode, type Dictionary } from "../lib/od";
 import { buildPath, type AxisView } from "../lib/router";
 import { axisStateText } from "../client/live";
 import { backupView } from "./backup";
@@ -23,6 +23,8 @@ export interface AxisViewPage {
   update?: Page["update"];
   dispose?(): void;
   focusSearch?(): boolean;
+  /** A shortcut of the view (scope: arm, force, stop); false when it is not the view's. */
+  shortcut?(action: string): boolean;
 }
 
 const VIEWS: [AxisView, string, string][] = [
@@ -30,6 +32,7 @@ const VIEWS: [AxisView, string, string][] = [
   ["parameters", "Parameters", "g p"],
   ["commissioning", "Commissioning", "g c"],
   ["backup", "Backup / restore", "g k"],
+  ["scope", "Scope", "g s"],
 ];
 
 export async function axisPage(context: PageContext, projectName: string, axisName: string, view: AxisView): Promise<Page> {
@@ -42,12 +45,14 @@ export async function axisPage(context: PageContext, projectName: string, axisNa
   if (!axis) {
     throw new Error(`Project ${projectName} has no axis "${axisName}" (axes: ${project.axes.map((a) => a.name).join(", ") || "none"}).`);
   }
-  const dictionary = await (known?.device === axis.device && early ? early : getDictionary(axis.device));
+  const shared = await (known?.device === axis.device && early ? early : getDictionary(axis.device));
+  const dictionary = forNode(shared, axis.node_id);
   const axisContext: AxisContext = { page: context, project, axis, dictionary };
   const viewPage = await (view === "dashboard" ? dashboardView(axisContext)
     : view === "parameters" ? parametersView(axisContext)
       : view === "commissioning" ? commissioningView(axisContext)
-        : backupView(axisContext));
+        : view === "scope" ? import("./scope").then((module) => module.scopeView(axisContext)) // plotly only here
+          : backupView(axisContext));
 
   // The header follows the live hub, which outlives the page: its binding is stopped with the page's scope.
   const scope = new Scope();
@@ -72,6 +77,7 @@ export async function axisPage(context: PageContext, projectName: string, axisNa
     element: h("div", { style: { display: "flex", flexDirection: "column", flex: "1", minHeight: "0" } }, wrapper, viewPage.element),
     update: viewPage.update,
     focusSearch: viewPage.focusSearch,
+    shortcut: viewPage.shortcut,
     dispose: () => {
       scope.dispose();
       viewPage.dispose?.();

@@ -5,6 +5,7 @@
  * socket: it samples, this page renders).
  */
 
+import { controllerPanel } from "../components/dashboard/controller";
 import { deviceControl } from "../components/dashboard/device-control";
 import { faultsPanel } from "../components/dashboard/faults";
 import { digitalIo } from "../components/dashboard/io";
@@ -13,6 +14,7 @@ import { DashboardModel } from "../components/dashboard/model";
 import { dashboardNotice } from "../components/dashboard/notice";
 import { quickTest } from "../components/dashboard/quick-test";
 import { statusWordPanel } from "../components/dashboard/status-word";
+import { heldByMe } from "../client/control";
 import { dashboardSignals } from "../lib/dashboard-objects";
 import { Scope, h } from "../lib/dom";
 import type { Entry } from "../lib/od";
@@ -35,6 +37,11 @@ function layout(model: DashboardModel): HTMLElement {
     columns("minmax(0, 1.35fr) minmax(0, 1fr)",
       control(model),
       h("div", { class: "grid", style: { alignContent: "start" } },
+        controllerPanel({
+          control: model.control, askedBy: model.askedBy, busy: model.busy, mayTakeOver: () => model.mayTakeOver(),
+          onArm: () => void model.arm(), onRelease: () => void model.release(),
+          onRequest: () => void model.request(), onTakeOver: () => void model.takeOver(),
+        }),
         faultsPanel({ report: model.faults, onReset: () => void model.runCommand("fault_reset") }),
         quickTestPanel(model))),
     measurementsPanel({ entries: model.signals.measurements, cell: (entry) => model.cell(entry).val, address: (entry) => model.key(entry) }),
@@ -51,6 +58,7 @@ function control(model: DashboardModel): HTMLElement {
   const active = () => (display ? model.cell(display).val.value?.raw : undefined);
   return deviceControl({
     statusword: model.statusword, reachable: model.reachable, busy: model.busy, nmt: model.nmt, connection: model.connection,
+    armed: () => heldByMe(model.control.val),
     mode: model.signals.mode,
     activeMode: () => {
       const raw = active();

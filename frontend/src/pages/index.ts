@@ -2,11 +2,13 @@
 
 import type { Page, PageContext } from "../app";
 import { h } from "../lib/dom";
+import { auditPage } from "./audit";
 import { axisPage } from "./axis";
 import { busPage } from "./bus";
 import { comparePage } from "./compare";
 import { dictionariesPage, dictionaryPage } from "./dictionaries";
 import { homePage } from "./home";
+import { loginPage, setupPage } from "./login";
 import { motorsPage } from "./motors";
 import { projectPage } from "./project";
 import { terminalPage } from "./terminal";
@@ -32,6 +34,12 @@ export async function mountPage(context: PageContext): Promise<Page> {
       return dictionaryPage(context, route.device);
     case "motors":
       return motorsPage(context);
+    case "audit":
+      return auditPage(context);
+    case "login":
+      return loginPage(context);
+    case "setup":
+      return setupPage(context);
     case "not-found":
       return {
         title: "Not found",

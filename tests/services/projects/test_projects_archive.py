@@ -176,6 +176,8 @@ def _project_with_axis_files(drivepar: bytes, sequence: bytes) -> list[tuple[str
     ("drivepar", "sequence", "message"),
     [
         (b"0x3051,0=1\n0x2004,0=12\n", b"", r"bad/X/DRIVEPAR.TXT:2: 0x2004,0 .* expected text"),
+        (b"0x3051,0=1\n0x304F,0=4194177\n", b"", r"bad/X/DRIVEPAR.TXT:2: 0x304F,0 .*4194176"),  # out of range
+        (b"0x1000,0=1\n", b"", r"bad/X/DRIVEPAR.TXT:1: 0x1000,0 .*read-only"),  # the editor cannot write it
         (b"0x3051,0=1\n0x3051,0=2\n", b"", r"bad/X/DRIVEPAR.TXT:2: duplicate assignment"),
         (b"", b"; sequences\ngarbage\n", r"bad/X/SEQUENCE.TXT:2: expected 'Key_word = value'"),
     ],
@@ -194,3 +196,28 @@ def test_archive_with_valid_axis_files_is_accepted(service: ProjectService, tmp_
     snapshot = service.unarchive(archive)
     assert [axis.name for axis in snapshot.project.axes] == ["X"]
     assert service.parameters.get("bad", "X", "0x3051")[0].value == 1
+
+
+def _with_nul_in_a_name(path: Path) -> Path:
+    """An archive whose member ``bad/X/DRIVEPAR.TXT`` is stored as ``bad/X/DRIVE\\0AR.TXT`` (``zipfile`` itself
+    writes no NUL; it reads the name cut at the NUL, which would make it a different file)."""
+    _zip(path, _project_with_axis_files(b"0x3051,0=1\n", b""))
+    data = path.read_bytes().replace(b"bad/X/DRIVEPAR.TXT", b"bad/X/DRIVE\0AR.TXT")
+    path.write_bytes(data)
+    return path
+
+
+def test_a_nul_anywhere_in_a_member_name_is_refused(service: ProjectService, tmp_path: Path):
+    with pytest.raises(ArchiveError, match=r"contains a NUL in its name"):
+        service.unarchive(_with_nul_in_a_name(tmp_path / "nul.zip"))
+    _assert_untouched(service, tmp_path)
+
+
+def test_refusals_name_the_archive_by_its_name_only(service: ProjectService, tmp_path: Path):
+    deep = tmp_path / "server" / "spool"
+    deep.mkdir(parents=True)
+    archive = _zip(deep / "upload.zip", _project_with_axis_files(b"0x304F,0=4194177\n", b""))
+    with pytest.raises(ArchiveError) as refused:
+        service.unarchive(archive)
+    assert str(refused.value).startswith("upload.zip: bad/X/DRIVEPAR.TXT:1:")
+    assert str(tmp_path) not in str(refused.value)

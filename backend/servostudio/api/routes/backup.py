@@ -4,19 +4,23 @@ from __future__ import annotations
 
 from typing import Annotated
 
-from fastapi import APIRouter, Body, Depends, Response, status
+from fastapi import APIRouter, Body, Response, status
 from fastapi.responses import JSONResponse, PlainTextResponse
 
-from servostudio.api.deps import Jobs, NodeDrive, OpenBus, Server, current_user
+from servostudio.api.deps import Jobs, NodeDrive, OpenBus, Server
 from servostudio.api.errors import error_responses
+from servostudio.api.limits import MIB, body_limit
 from servostudio.api.routes.comm_models import BackupRequest, JobModel, RestoreRequest
 from servostudio.api.routes.drives import DRIVE_ERRORS
+from servostudio.api.security import Requires
 from servostudio.errors import ErrorKind
 from servostudio.services import transfers
+from servostudio.services.users import Level
 
-router = APIRouter(tags=["backup"], dependencies=[Depends(current_user)])
+router = APIRouter(tags=["backup"])
 #: A drive file as uploaded: its bytes (8-bit text, read as Latin-1, so any byte is accepted); an empty body is an
 #: empty file, which is valid (it sets nothing).
+DRIVE_FILE_BYTES = 1 * MIB  # a full SEQUENCE.TXT (128 sequences) is about 100 kB
 FileBytes = Annotated[bytes, Body(media_type="text/plain", description="the drive file (8-bit text, Latin-1)")]
 
 
@@ -26,6 +30,7 @@ FileBytes = Annotated[bytes, Body(media_type="text/plain", description="the driv
     status_code=status.HTTP_202_ACCEPTED,
     summary="Back up drives in parallel into DIRECTORY/node<N>/ (progress on /api/ws/events)",
     responses=error_responses(ErrorKind.NOT_FOUND),
+    dependencies=[Requires(Level.MAINTENANCE)],
 )
 def start_backup(request: BackupRequest, connection: OpenBus, jobs: Jobs, server: Server) -> dict:
     roots = server.settings.transfer_roots
@@ -38,6 +43,7 @@ def start_backup(request: BackupRequest, connection: OpenBus, jobs: Jobs, server
     status_code=status.HTTP_202_ACCEPTED,
     summary="Restore drives in parallel from DIRECTORY/node<N>/ (validated first, verified, stored)",
     responses=error_responses(ErrorKind.NOT_FOUND),
+    dependencies=[Requires(Level.MAINTENANCE)],
 )
 def start_restore(request: RestoreRequest, connection: OpenBus, jobs: Jobs, server: Server) -> dict:
     roots = server.settings.transfer_roots
@@ -47,7 +53,7 @@ def start_restore(request: RestoreRequest, connection: OpenBus, jobs: Jobs, serv
     return job.as_dict()
 
 
-@router.get("/jobs", response_model=list[JobModel], summary="Recent jobs")
+@router.get("/jobs", response_model=list[JobModel], summary="Recent jobs", dependencies=[Requires(Level.OPERATOR)])
 def list_jobs(jobs: Jobs) -> list[dict]:
     return [job.as_dict() for job in jobs.list()]
 
@@ -57,6 +63,7 @@ def list_jobs(jobs: Jobs) -> list[dict]:
     response_model=JobModel,
     summary="Cancel a running job: it stops at the next object or file boundary and ends 'cancelled'",
     responses=error_responses(ErrorKind.NOT_FOUND),
+    dependencies=[Requires(Level.MAINTENANCE)],
 )
 def cancel_job(job_id: str, jobs: Jobs) -> dict:
     return jobs.cancel(job_id).as_dict()
@@ -67,6 +74,7 @@ def cancel_job(job_id: str, jobs: Jobs) -> dict:
     response_model=JobModel,
     summary="A job's state and result",
     responses=error_responses(ErrorKind.NOT_FOUND),
+    dependencies=[Requires(Level.OPERATOR)],
 )
 def get_job(job_id: str, jobs: Jobs) -> dict:
     return jobs.get(job_id).as_dict()
@@ -77,6 +85,7 @@ def get_job(job_id: str, jobs: Jobs) -> dict:
     response_class=PlainTextResponse,
     summary="Back up one file of one drive and download it (DRIVEPAR.TXT, USER_PAR.TXT, SEQUENCE.TXT)",
     responses=error_responses(*DRIVE_ERRORS),
+    dependencies=[Requires(Level.MAINTENANCE)],
 )
 def download_file(name: str, drive: NodeDrive) -> str:
     return transfers.download(drive, transfers.file_kind(name))
@@ -86,7 +95,12 @@ def download_file(name: str, drive: NodeDrive) -> str:
     "/buses/{bus}/nodes/{node}/files/{name}",
     summary="Upload a file and restore it to the drive (validated first; 422 names the line); with "
     "job=true as a cancellable job (202, progress on /api/ws/events)",
-    responses=error_responses(*DRIVE_ERRORS),
+    responses={
+        **error_responses(*DRIVE_ERRORS, ErrorKind.TOO_LARGE),
+        status.HTTP_202_ACCEPTED: {"model": JobModel, "description": "with job=true: the restore job, started"},
+    },
+    openapi_extra=body_limit(DRIVE_FILE_BYTES),
+    dependencies=[Requires(Level.MAINTENANCE)],
 )
 def upload_file(
     name: str,

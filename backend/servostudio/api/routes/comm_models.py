@@ -139,6 +139,15 @@ class FaultInfoModel(BaseModel):
     remedy: str
 
 
+class FaultCauseModel(BaseModel):
+    """An object a failed procedure needed, seen at 0 or out of its range: the cause the drive does not report."""
+
+    object: str = Field(examples=["0x6410,11 Motor data.Torque constant"])
+    value: int | float
+    problem: str = Field(examples=["is 0", "is outside 1..24"])
+    needed_by: str = Field(examples=["auto-tuning"])
+
+
 class FaultReportModel(BaseModel):
     model_config = _example(
         node=1,
@@ -160,6 +169,9 @@ class FaultReportModel(BaseModel):
     error_text: str
     faults: list[FaultInfoModel]
     warnings: list[FaultInfoModel]
+    causes: list[FaultCauseModel] = Field(
+        default_factory=list, description="what the tool sees behind a procedure fault (empty: nothing it can see)"
+    )
 
 
 class BackupRequest(BaseModel):

@@ -4,17 +4,22 @@ from __future__ import annotations
 
 from typing import Annotated
 
-from fastapi import APIRouter, Depends, File, UploadFile
+from fastapi import APIRouter, File, UploadFile
 from pydantic import BaseModel, Field
 from starlette.concurrency import run_in_threadpool
 
-from servostudio.api.deps import Library, current_user
+from servostudio.api.deps import Library
 from servostudio.api.errors import error_responses
+from servostudio.api.limits import MIB, body_limit
+from servostudio.api.security import Requires
 from servostudio.errors import ErrorKind
 from servostudio.od import EdsLibrary, ObjectDictionary, Variable
 from servostudio.services import dictionaries
+from servostudio.services.users import Level, write_level
 
-router = APIRouter(prefix="/dictionaries", tags=["dictionaries"], dependencies=[Depends(current_user)])
+router = APIRouter(prefix="/dictionaries", tags=["dictionaries"])
+#: an EDS with its properties, as multipart: the largest drive dictionaries are a few hundred kilobytes
+EDS_UPLOAD_BYTES = 8 * MIB
 
 
 class DictionarySummary(BaseModel):
@@ -43,7 +48,18 @@ class EntryModel(BaseModel):
     pdo_mappable: bool
     low: int | float | None
     high: int | float | None
-    default: int | float | str | None
+    default: int | float | str | None = Field(
+        description="DefaultValue; a default that depends on the node ID stays the EDS expression ('$NODEID+0x180')"
+    )
+    default_node_offset: int | None = Field(
+        None, description="for a '$NODEID' default: the value for node n is n + this offset; null otherwise"
+    )
+    configured: int | float | str | None = Field(
+        None, description="a DCF's ParameterValue (the value commissioning configured), '$NODEID' kept as default"
+    )
+    configured_node_offset: int | None = Field(
+        None, description="for a '$NODEID' ParameterValue: the configured value for node n is n + this offset"
+    )
     unit: str
     scale: float
     offset: float
@@ -54,6 +70,9 @@ class EntryModel(BaseModel):
     bits: list[BitFieldModel]
     is_pointer: bool
     reference: str
+    write_level: Level | None = Field(
+        description="the lowest user level that may write it (null: nobody, read-only); docs/security.md"
+    )
 
 
 class ObjectModel(BaseModel):
@@ -81,8 +100,17 @@ def _summary(library: EdsLibrary, od: ObjectDictionary) -> dict:
     }
 
 
+def _shown(value: object, expression: str | None, node_offset: int | None) -> int | float | str | None:
+    """A dictionary value as the API shows it without a node: a '$NODEID' value as its expression (the number
+    depends on the node, given by the ``*_node_offset`` field), bytes as hex."""
+    if node_offset is not None:
+        return expression
+    if isinstance(value, bytes):
+        return value.hex()
+    return value if isinstance(value, (int, float, str)) else None
+
+
 def _entry(var: Variable) -> EntryModel:
-    default = var.default.hex() if isinstance(var.default, bytes) else var.default
     return EntryModel(
         subindex=var.subindex,
         name=var.name,
@@ -91,7 +119,10 @@ def _entry(var: Variable) -> EntryModel:
         pdo_mappable=var.pdo_mappable,
         low=var.low,
         high=var.high,
-        default=default,
+        default=_shown(var.default, var.default_expr, var.default_node_offset),
+        default_node_offset=var.default_node_offset,
+        configured=_shown(var.parameter_value, var.parameter_expr, var.parameter_node_offset),
+        configured_node_offset=var.parameter_node_offset,
         unit=var.unit,
         scale=var.scale,
         offset=var.offset,
@@ -102,15 +133,21 @@ def _entry(var: Variable) -> EntryModel:
         bits=[BitFieldModel(first=b.first, last=b.last, name=b.name) for b in var.bits],
         is_pointer=var.is_pointer,
         reference=var.reference,
+        write_level=write_level(var),
     )
 
 
-@router.get("", response_model=list[DictionarySummary])
+@router.get("", response_model=list[DictionarySummary], dependencies=[Requires(Level.OPERATOR)])
 def list_dictionaries(library: Library) -> list[dict]:
     return [_summary(library, library.load(device)) for device in library.devices()]
 
 
-@router.get("/{device}", response_model=DictionaryModel, responses=error_responses(ErrorKind.NOT_FOUND))
+@router.get(
+    "/{device}",
+    response_model=DictionaryModel,
+    responses=error_responses(ErrorKind.NOT_FOUND),
+    dependencies=[Requires(Level.OPERATOR)],
+)
 def get_dictionary(device: str, library: Library) -> DictionaryModel:
     od = dictionaries.dictionary(library, device)
     objects = [
@@ -127,7 +164,14 @@ def get_dictionary(device: str, library: Library) -> DictionaryModel:
     return DictionaryModel(**_summary(library, od), groups=groups, objects=objects)
 
 
-@router.post("", response_model=DictionarySummary, status_code=201)
+@router.post(
+    "",
+    response_model=DictionarySummary,
+    status_code=201,
+    responses=error_responses(ErrorKind.TOO_LARGE),
+    openapi_extra=body_limit(EDS_UPLOAD_BYTES),
+    dependencies=[Requires(Level.ADMINISTRATOR)],
+)
 async def import_dictionary(
     library: Library,
     eds: Annotated[UploadFile, File(description="CiA 306 EDS file")],

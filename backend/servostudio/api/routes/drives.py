@@ -2,9 +2,9 @@
 
 from __future__ import annotations
 
-from fastapi import APIRouter, Depends
+from fastapi import APIRouter
 
-from servostudio.api.deps import Motion, MotionClient, NodeDrive, OpenBus, current_user
+from servostudio.api.deps import Motion, NodeDrive, OpenBus
 from servostudio.api.errors import error_responses
 from servostudio.api.routes.comm_models import (
     DriveState,
@@ -15,10 +15,12 @@ from servostudio.api.routes.comm_models import (
     ReadResult,
     StateRequest,
 )
+from servostudio.api.security import ObjectWriteLevel, Requires
 from servostudio.drive.control import fault_report
 from servostudio.errors import ErrorKind
 from servostudio.services import device_control
 from servostudio.services.terminal import read_objects
+from servostudio.services.users import Level
 
 #: what talking to a drive may meet: unknown bus/node/object, a refusal, a bus down, no answer
 DRIVE_ERRORS = (
@@ -32,7 +34,6 @@ DRIVE_ERRORS = (
 router = APIRouter(
     prefix="/buses/{bus}/nodes/{node}",
     tags=["drives"],
-    dependencies=[Depends(current_user)],
     responses=error_responses(*DRIVE_ERRORS),
 )
 
@@ -41,6 +42,7 @@ router = APIRouter(
     "/objects/{key}",
     response_model=ObjectValueModel,
     summary="Read an object by address (0x6041, 0x60F9,2), name, or profile name (statusword)",
+    dependencies=[Requires(Level.OPERATOR)],
 )
 def read_object(key: str, drive: NodeDrive) -> dict:
     return drive.read(key).as_dict()
@@ -50,36 +52,56 @@ def read_object(key: str, drive: NodeDrive) -> dict:
     "/objects/{key}",
     response_model=ObjectValueModel,
     summary="Write an object; access, type and range are checked before anything is sent",
+    dependencies=[Requires(Level.OPERATOR), ObjectWriteLevel],
 )
-def write_object(
-    bus: str, key: str, request: ObjectWrite, drive: NodeDrive, motion: Motion, client: MotionClient = None
-) -> dict:
-    return motion.write(client, (bus, drive.node), drive, key, request.value, request.physical).as_dict()
+def write_object(key: str, request: ObjectWrite, drive: NodeDrive) -> dict:
+    """A motion object (control word, mode, target) needs the axis's armed controller: send X-Servo-Client."""
+    return drive.write(key, request.value, request.physical).as_dict()
 
 
-@router.post("/read", response_model=list[ReadResult], summary="Read several objects of this node at once")
+@router.post(
+    "/read",
+    response_model=list[ReadResult],
+    summary="Read several objects of this node at once",
+    dependencies=[Requires(Level.OPERATOR)],
+)
 def read_many(request: ReadMany, drive: NodeDrive) -> list[dict]:
     return read_objects(drive, request.objects)
 
 
-@router.get("/state", response_model=DriveState, summary="CiA 402 state and NMT state")
+@router.get(
+    "/state", response_model=DriveState, summary="CiA 402 state and NMT state", dependencies=[Requires(Level.OPERATOR)]
+)
 def get_state(connection: OpenBus, drive: NodeDrive) -> dict:
     return device_control.drive_state(connection, drive)
 
 
-@router.put("/state", response_model=DriveState, summary="Walk the CiA 402 state machine to a target state")
-def put_state(
-    request: StateRequest, connection: OpenBus, drive: NodeDrive, motion: Motion, client: MotionClient = None
-) -> dict:
-    """Enabling (operation-enabled) needs a live motion client, which then answers for the axis."""
-    return device_control.change_state(connection, motion, client, drive, request.target)
+@router.put(
+    "/state",
+    response_model=DriveState,
+    summary="Walk the CiA 402 state machine to a target state",
+    dependencies=[Requires(Level.MAINTENANCE)],
+)
+def put_state(request: StateRequest, connection: OpenBus, drive: NodeDrive, motion: Motion) -> dict:
+    """Enabling (operation-enabled) needs the axis armed by the caller's live client (X-Servo-Client)."""
+    return device_control.change_state(connection, motion, drive, request.target)
 
 
-@router.get("/faults", response_model=FaultReportModel, summary="Active faults and warnings with the manual's remedy")
+@router.get(
+    "/faults",
+    response_model=FaultReportModel,
+    summary="Active faults and warnings with the manual's remedy",
+    dependencies=[Requires(Level.OPERATOR)],
+)
 def get_faults(drive: NodeDrive) -> dict:
     return fault_report(drive).as_dict()
 
 
-@router.post("/faults/reset", response_model=FaultReportModel, summary="Fault reset (control word bit 7 edge)")
+@router.post(
+    "/faults/reset",
+    response_model=FaultReportModel,
+    summary="Fault reset (control word bit 7 edge)",
+    dependencies=[Requires(Level.MAINTENANCE)],
+)
 def post_fault_reset(connection: OpenBus, drive: NodeDrive) -> dict:
     return device_control.reset_faults(connection, drive).as_dict()

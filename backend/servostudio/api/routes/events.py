@@ -7,7 +7,7 @@ status words are polled slowly (``services.bus.statewatch``).  ``/api/ws/events?
 Terminal protocol (client → server): ``{"op": "watch", "items": [{"bus", "node", "object"}…], "period_ms": 200}``
 starts continuous monitoring (``{"op": "watch", "items": []}`` stops it), ``{"op": "read", "items": […]}`` reads once,
 ``{"op": "write", "bus", "node", "object", "value", "physical", "client"}`` writes (``client``: the motion client
-id from /api/ws/events, needed for a control word that enables operation).  Server → client: ``{"type": "values",
+id from /api/ws/events, needed for motion: docs/motion-safety.md).  Server → client: ``{"type": "values",
 "rows": [...]}``, ``{"type": "written", "value": {...}}``, ``{"type": "error", "detail", "error", "kind"}`` (the
 fields of the REST error body).
 """
@@ -20,29 +20,39 @@ import logging
 from collections.abc import Callable
 from typing import Any, TypeVar
 
-from fastapi import APIRouter, Depends, WebSocket, WebSocketDisconnect
+from fastapi import APIRouter, WebSocket, WebSocketDisconnect
 
-from servostudio.api.deps import Connections, Events, Motion, current_user
+from servostudio.api.auth import identify
+from servostudio.api.deps import Access, Caller, Connections, Events, Motion
 from servostudio.api.errors import error_body
+from servostudio.api.security import Requires, require_message
 from servostudio.errors import ServoStudioError
+from servostudio.services.audit import Actor, acting_as
 from servostudio.services.bus import ConnectionManager
 from servostudio.services.motion import MotionGuard
 from servostudio.services.terminal import TerminalError, Watch, WatchItem, sample
+from servostudio.services.users import AccessControl, Level, User, check_write
 
-router = APIRouter(tags=["events"], dependencies=[Depends(current_user)])
+router = APIRouter(tags=["events"])
 log = logging.getLogger(__name__)
 T = TypeVar("T")
+#: the level each client message needs, checked per message with the caller as it is then (a session that ended
+#: or a level lowered meanwhile applies at once); a write needs the object's own level too
+TERMINAL_MESSAGES: dict[str, Level] = {"read": Level.OPERATOR, "watch": Level.OPERATOR, "write": Level.MAINTENANCE}
+#: the event socket reads client messages only to notice a disconnect: none does anything, so none needs a level
+EVENT_MESSAGES: dict[str, Level] = {}
 
 
-@router.websocket("/ws/events")
+@router.websocket("/ws/events", dependencies=[Requires(Level.OPERATOR)])
 async def events_socket(
-    socket: WebSocket, hub: Events, motion: Motion, manager: Connections, types: str | None = None
+    socket: WebSocket, hub: Events, motion: Motion, manager: Connections, user: Caller, types: str | None = None
 ) -> None:
     """Events as they happen. The socket is also the caller's motion client: its first message,
-    ``{"type": "hello", "client": ID}``, gives the id that enabling a drive must name (X-Servo-Client), and the
-    axes it enabled get a quick stop when the socket closes."""
+    ``{"type": "hello", "client": ID}``, gives the id that arming an axis and every motion request must name
+    (X-Servo-Client); the axes it holds get a quick stop when the socket closes.  An event addressed to one client
+    (``"to"``: a ``control_request`` for the axis's holder) goes to that client only."""
     await socket.accept()
-    client = motion.connect()
+    client = motion.connect(user.name)
     subscription = hub.subscribe(set(types.split(",")) if types else None)
     receiver = asyncio.create_task(_drain(socket))
     try:
@@ -50,7 +60,7 @@ async def events_socket(
         while not receiver.done():
             getter = asyncio.create_task(subscription.get())
             done, _ = await asyncio.wait({getter, receiver}, return_when=asyncio.FIRST_COMPLETED)
-            if getter in done:
+            if getter in done and getter.result().get("to") in (None, client):
                 await socket.send_json(getter.result())
             else:
                 getter.cancel()
@@ -69,11 +79,11 @@ async def _drain(socket: WebSocket) -> None:
             await socket.receive_text()
 
 
-@router.websocket("/ws/terminal")
-async def terminal_socket(socket: WebSocket, manager: Connections, motion: Motion) -> None:
+@router.websocket("/ws/terminal", dependencies=[Requires(Level.OPERATOR)])
+async def terminal_socket(socket: WebSocket, manager: Connections, motion: Motion, control: Access) -> None:
     """One request per message; a refusal is answered as an error message and the terminal stays open."""
     await socket.accept()
-    terminal = _Terminal(socket, manager, motion)
+    terminal = _Terminal(socket, manager, motion, control)
     try:
         while True:
             await terminal.answer(await socket.receive_json())
@@ -86,8 +96,10 @@ async def terminal_socket(socket: WebSocket, manager: Connections, motion: Motio
 class _Terminal:
     """One terminal socket: its requests and the watch it runs."""
 
-    def __init__(self, socket: WebSocket, manager: ConnectionManager, motion: MotionGuard) -> None:
-        self.socket, self.manager, self.motion = socket, manager, motion
+    def __init__(
+        self, socket: WebSocket, manager: ConnectionManager, motion: MotionGuard, control: AccessControl
+    ) -> None:
+        self.socket, self.manager, self.motion, self.control = socket, manager, motion, control
         self.monitor: asyncio.Task | None = None
 
     async def answer(self, message: object) -> None:
@@ -105,8 +117,10 @@ class _Terminal:
 
     async def _handle(self, message: dict) -> None:
         operation = message.get("op")
+        caller = identify(self.socket, self.control)
+        require_message(caller, TERMINAL_MESSAGES, str(operation), "terminal")
         if operation == "write":
-            value = await asyncio.to_thread(self._write, message)
+            value = await asyncio.to_thread(self._write, message, caller)
             await self.socket.send_json({"type": "written", "value": value})
         elif operation in ("read", "watch"):
             watch = _watch(message)
@@ -120,14 +134,17 @@ class _Terminal:
         else:
             raise TerminalError(f"unknown op {operation!r}; use read, watch or write")
 
-    def _write(self, message: dict) -> dict[str, object]:
-        """A terminal write, through the motion guard like every write (``client``: the caller's motion client)."""
+    def _write(self, message: dict, caller: User) -> dict[str, object]:
+        """A terminal write, at the object's level and through the motion guard like every write (``client``: the
+        caller's motion client)."""
         bus, node, key = _field(message, "bus", str), _field(message, "node", int), _field(message, "object", str)
         if "value" not in message:
             raise TerminalError("missing 'value'")
         drive = self.manager.get(bus).drive(node)
+        check_write(caller, drive.variable(key))
         physical = bool(message.get("physical", False))
-        return self.motion.write(message.get("client"), (bus, node), drive, key, message["value"], physical).as_dict()
+        with acting_as(Actor(caller.name, str(caller.level), message.get("client"))):
+            return drive.write(key, message["value"], physical).as_dict()
 
     def stop_watch(self) -> None:
         if self.monitor is not None:

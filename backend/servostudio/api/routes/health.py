@@ -4,6 +4,7 @@ from fastapi import APIRouter
 from pydantic import BaseModel
 
 from servostudio import __version__
+from servostudio.api.security import Anyone
 
 router = APIRouter(tags=["health"])
 
@@ -13,6 +14,6 @@ class Health(BaseModel):
     version: str
 
 
-@router.get("/health", response_model=Health)
+@router.get("/health", response_model=Health, dependencies=[Anyone])
 def get_health() -> Health:
     return Health(status="ok", version=__version__)

@@ -14,13 +14,14 @@ from pathlib import Path
 from typing import Annotated
 
 import anyio
-from fastapi import APIRouter, Depends, Query, Request, Response
+from fastapi import APIRouter, Query, Request, Response
 from fastapi.responses import FileResponse
 from starlette.background import BackgroundTask
 from starlette.concurrency import run_in_threadpool
 
-from servostudio.api.deps import Live, Projects, current_user
+from servostudio.api.deps import Live, Projects
 from servostudio.api.errors import error_responses
+from servostudio.api.limits import body_limit
 from servostudio.api.routes import projects_live
 from servostudio.api.routes.drives import DRIVE_ERRORS
 from servostudio.api.routes.project_models import (
@@ -46,9 +47,9 @@ from servostudio.api.routes.project_models import (
     parameter_model,
     project_model,
 )
+from servostudio.api.security import Requires
 from servostudio.errors import ErrorKind
 from servostudio.services.projects import ArchiveLimits, Axis, Motor, errors
-from servostudio.services.projects.errors import ArchiveTooLarge
 from servostudio.services.projects.jsonview import (
     choice_view,
     compare_view,
@@ -57,23 +58,28 @@ from servostudio.services.projects.jsonview import (
     template_view,
 )
 from servostudio.services.projects.templates import templates_for
+from servostudio.services.users import Level
 
 #: what the project routes may answer besides their result (the live ones meet the drives' errors too)
 PROJECT_ERRORS = (ErrorKind.NOT_FOUND, ErrorKind.CONFLICT)
-router = APIRouter(tags=["projects"], dependencies=[Depends(current_user)], responses=error_responses(*PROJECT_ERRORS))
+router = APIRouter(tags=["projects"], responses=error_responses(*PROJECT_ERRORS))
 
 
 # ---- projects ---------------------------------------------------------------------------------------------------
 
 
-@router.get("/projects", response_model=list[ProjectSummary])
+@router.get("/projects", response_model=list[ProjectSummary], dependencies=[Requires(Level.OPERATOR)])
 def list_projects(service: Projects) -> list[ProjectSummary]:
     return [ProjectSummary(**summary) for summary in summaries(service.store)]
 
 
-@router.post("/projects", response_model=ProjectModel, status_code=201)
+@router.post("/projects", response_model=ProjectModel, status_code=201, dependencies=[Requires(Level.EXPERT)])
 def create_project(body: ProjectCreate, service: Projects) -> ProjectModel:
     return project_model(service.store.create(body.name, body.description, buses_from(body.buses)))
+
+
+#: an archive upload is compressed: it cannot usefully exceed what its members may add up to
+ARCHIVE_UPLOAD_BYTES = ArchiveLimits().max_total_bytes
 
 
 @router.post(
@@ -81,58 +87,58 @@ def create_project(body: ProjectCreate, service: Projects) -> ProjectModel:
     response_model=ProjectModel,
     status_code=201,
     responses=error_responses(ErrorKind.TOO_LARGE),
+    openapi_extra=body_limit(ARCHIVE_UPLOAD_BYTES),
+    dependencies=[Requires(Level.EXPERT)],
 )
 async def unarchive(
     request: Request, service: Projects, new_name: Annotated[str | None, Query()] = None
 ) -> ProjectModel:
-    """Body: the zip archive (``application/zip``). Its size is limited before anything is unpacked."""
-    limits = ArchiveLimits()
+    """Body: the zip archive (``application/zip``). Its size is limited (``api.limits``) before anything is
+    unpacked."""
     with tempfile.TemporaryDirectory() as scratch:
         path = Path(scratch) / "upload.zip"
-        await _receive(request, path, limits.max_total_bytes)
-        snapshot = await run_in_threadpool(service.unarchive, path, new_name, limits)
+        await _receive(request, path)
+        snapshot = await run_in_threadpool(service.unarchive, path, new_name)
     return project_model(snapshot)
 
 
-async def _receive(request: Request, path: Path, limit: int) -> None:
-    """Spool the request body to ``path``, refusing it as soon as it passes ``limit`` bytes."""
-    size = 0
+async def _receive(request: Request, path: Path) -> None:
+    """Spool the request body to ``path`` (the body limit stops it early)."""
     async with await anyio.open_file(path, "wb") as stream:
         async for chunk in request.stream():
-            size += len(chunk)
-            if size > limit:
-                raise ArchiveTooLarge(f"archive larger than {limit} bytes")
             await stream.write(chunk)
 
 
-@router.get("/projects/{name}", response_model=ProjectModel)
+@router.get("/projects/{name}", response_model=ProjectModel, dependencies=[Requires(Level.OPERATOR)])
 def get_project(name: str, service: Projects) -> ProjectModel:
     return project_model(service.store.open(name))
 
 
-@router.patch("/projects/{name}", response_model=ProjectModel)
+@router.patch("/projects/{name}", response_model=ProjectModel, dependencies=[Requires(Level.EXPERT)])
 def update_project(name: str, body: ProjectUpdate, service: Projects) -> ProjectModel:
     buses = buses_from(body.buses) if body.buses is not None else None
     return project_model(service.store.update(name, body.revision, description=body.description, buses=buses))
 
 
-@router.delete("/projects/{name}", status_code=204)
+@router.delete("/projects/{name}", status_code=204, dependencies=[Requires(Level.EXPERT)])
 def delete_project(name: str, service: Projects, revision: str | None = None) -> Response:
     service.store.delete(name, revision)
     return Response(status_code=204)
 
 
-@router.post("/projects/{name}/rename", response_model=ProjectModel)
+@router.post("/projects/{name}/rename", response_model=ProjectModel, dependencies=[Requires(Level.EXPERT)])
 def rename_project(name: str, body: NewName, service: Projects) -> ProjectModel:
     return project_model(service.store.rename(name, body.new_name, body.revision))
 
 
-@router.post("/projects/{name}/duplicate", response_model=ProjectModel, status_code=201)
+@router.post(
+    "/projects/{name}/duplicate", response_model=ProjectModel, status_code=201, dependencies=[Requires(Level.EXPERT)]
+)
 def duplicate_project(name: str, body: NewName, service: Projects) -> ProjectModel:
     return project_model(service.store.duplicate(name, body.new_name))
 
 
-@router.get("/projects/{name}/archive", response_class=FileResponse)
+@router.get("/projects/{name}/archive", response_class=FileResponse, dependencies=[Requires(Level.OPERATOR)])
 def archive_project(name: str, service: Projects) -> FileResponse:
     scratch = tempfile.mkdtemp()
     path = service.archive(name, Path(scratch) / f"{name}.zip")
@@ -148,24 +154,28 @@ def _remove_tree(path: str) -> None:
 # ---- axes -------------------------------------------------------------------------------------------------------
 
 
-@router.post("/projects/{name}/axes", response_model=ProjectModel, status_code=201)
+@router.post(
+    "/projects/{name}/axes", response_model=ProjectModel, status_code=201, dependencies=[Requires(Level.EXPERT)]
+)
 def add_axis(name: str, body: AxisCreate, service: Projects) -> ProjectModel:
     axis = Axis(body.name, body.device, body.node_id, body.bus, body.description)
     return project_model(service.store.add_axis(name, axis, body.revision))
 
 
-@router.patch("/projects/{name}/axes/{axis}", response_model=ProjectModel)
+@router.patch("/projects/{name}/axes/{axis}", response_model=ProjectModel, dependencies=[Requires(Level.EXPERT)])
 def edit_axis(name: str, axis: str, body: AxisUpdate, service: Projects) -> ProjectModel:
     changes = body.model_dump(exclude_none=True, exclude={"revision"})
     return project_model(service.store.edit_axis(name, axis, body.revision, **changes))
 
 
-@router.delete("/projects/{name}/axes/{axis}", response_model=ProjectModel)
+@router.delete("/projects/{name}/axes/{axis}", response_model=ProjectModel, dependencies=[Requires(Level.EXPERT)])
 def remove_axis(name: str, axis: str, service: Projects, revision: str | None = None) -> ProjectModel:
     return project_model(service.store.remove_axis(name, axis, revision))
 
 
-@router.get("/projects/{name}/axes/{axis}/parameters", response_model=ParameterList)
+@router.get(
+    "/projects/{name}/axes/{axis}/parameters", response_model=ParameterList, dependencies=[Requires(Level.OPERATOR)]
+)
 def list_parameters(
     name: str,
     axis: str,
@@ -181,26 +191,37 @@ def list_parameters(
     return ParameterList(parameters=[parameter_model(row) for row in rows], revision=revision)
 
 
-@router.get("/projects/{name}/axes/{axis}/parameters/{address}", response_model=ParameterModel)
+@router.get(
+    "/projects/{name}/axes/{axis}/parameters/{address}",
+    response_model=ParameterModel,
+    dependencies=[Requires(Level.OPERATOR)],
+)
 def get_parameter(name: str, axis: str, address: str, service: Projects) -> ParameterModel:
     row, _revision = service.parameters.get(name, axis, address)
     return parameter_model(row)
 
 
-@router.put("/projects/{name}/axes/{axis}/parameters", response_model=ParameterList)
+@router.put(
+    "/projects/{name}/axes/{axis}/parameters", response_model=ParameterList, dependencies=[Requires(Level.EXPERT)]
+)
 def set_parameters(name: str, axis: str, body: ParameterWrite, service: Projects) -> ParameterList:
     change = service.parameters.set(name, axis, body.values, body.revision)
     return ParameterList(parameters=[parameter_model(row) for row in change.rows], revision=change.revision)
 
 
-@router.post("/projects/{name}/axes/{axis}/parameters/reset", response_model=ParameterList)
+@router.post(
+    "/projects/{name}/axes/{axis}/parameters/reset", response_model=ParameterList, dependencies=[Requires(Level.EXPERT)]
+)
 def reset_parameters(name: str, axis: str, body: ParameterReset, service: Projects) -> ParameterList:
     change = service.parameters.unset(name, axis, body.addresses, body.revision)
     return ParameterList(parameters=[parameter_model(row) for row in change.rows], revision=change.revision)
 
 
 @router.get(
-    "/projects/{name}/axes/{axis}/compare", response_model=CompareModel, responses=error_responses(*DRIVE_ERRORS)
+    "/projects/{name}/axes/{axis}/compare",
+    response_model=CompareModel,
+    responses=error_responses(*DRIVE_ERRORS),
+    dependencies=[Requires(Level.OPERATOR)],
 )
 def compare_axis(
     name: str,
@@ -228,7 +249,10 @@ def compare_axis(
 
 
 @router.post(
-    "/projects/{name}/axes/{axis}/motor", response_model=AxisChoiceModel, responses=error_responses(*DRIVE_ERRORS)
+    "/projects/{name}/axes/{axis}/motor",
+    response_model=AxisChoiceModel,
+    responses=error_responses(*DRIVE_ERRORS),
+    dependencies=[Requires(Level.EXPERT)],
 )
 def select_motor(name: str, axis: str, body: MotorChoice, service: Projects, live: Live) -> AxisChoiceModel:
     """Offline: the project reproduces the drive's side effects. With ``drive: true`` the motor is written to the
@@ -240,18 +264,24 @@ def select_motor(name: str, axis: str, body: MotorChoice, service: Projects, liv
     return AxisChoiceModel(**choice_view(choice))
 
 
-@router.get("/projects/{name}/axes/{axis}/application", response_model=TemplateModel | None)
+@router.get(
+    "/projects/{name}/axes/{axis}/application",
+    response_model=TemplateModel | None,
+    dependencies=[Requires(Level.OPERATOR)],
+)
 def get_application(name: str, axis: str, service: Projects) -> TemplateModel | None:
     chosen = service.application(name, axis)
     return TemplateModel(**template_view(chosen)) if chosen is not None else None
 
 
-@router.post("/projects/{name}/axes/{axis}/application", response_model=AxisChoiceModel)
+@router.post(
+    "/projects/{name}/axes/{axis}/application", response_model=AxisChoiceModel, dependencies=[Requires(Level.EXPERT)]
+)
 def apply_application(name: str, axis: str, body: TemplateChoice, service: Projects) -> AxisChoiceModel:
     return AxisChoiceModel(**choice_view(service.apply_template(name, axis, body.template, body.revision)))
 
 
-@router.get("/projects/{name}/axes/{axis}/dcf")
+@router.get("/projects/{name}/axes/{axis}/dcf", dependencies=[Requires(Level.OPERATOR)])
 def export_dcf(name: str, axis: str, service: Projects) -> Response:
     text = service.dcf(name, axis)
     return Response(
@@ -264,12 +294,12 @@ def export_dcf(name: str, axis: str, service: Projects) -> Response:
 # ---- catalog and templates --------------------------------------------------------------------------------------
 
 
-@router.get("/motors", response_model=list[MotorModel])
+@router.get("/motors", response_model=list[MotorModel], dependencies=[Requires(Level.OPERATOR)])
 def list_motors(service: Projects) -> list[MotorModel]:
     return [MotorModel(**motor_view(motor)) for motor in service.motors.motors()]
 
 
-@router.post("/motors", response_model=MotorModel, status_code=201)
+@router.post("/motors", response_model=MotorModel, status_code=201, dependencies=[Requires(Level.EXPERT)])
 def add_motor(body: MotorModel, service: Projects) -> MotorModel:
     """ "Add new motor": a user catalog entry (built-in references cannot be reused)."""
     objects = {}
@@ -283,14 +313,14 @@ def add_motor(body: MotorModel, service: Projects) -> MotorModel:
     return MotorModel(**motor_view(service.motors.add(motor)))
 
 
-@router.delete("/motors/{reference}", status_code=204)
+@router.delete("/motors/{reference}", status_code=204, dependencies=[Requires(Level.EXPERT)])
 def remove_motor(reference: str, service: Projects) -> Response:
     """Remove a user motor (built-in motors stay)."""
     service.motors.remove(reference)
     return Response(status_code=204)
 
 
-@router.get("/device-templates", response_model=list[TemplateModel])
+@router.get("/device-templates", response_model=list[TemplateModel], dependencies=[Requires(Level.OPERATOR)])
 def list_templates(device: str = "xtrapulspac") -> list[TemplateModel]:
     return [TemplateModel(**template_view(template)) for template in templates_for(device)]
 

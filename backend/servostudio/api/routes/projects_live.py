@@ -10,16 +10,18 @@ from __future__ import annotations
 
 from typing import Literal
 
-from fastapi import APIRouter, Depends, status
+from fastapi import APIRouter, status
 from pydantic import BaseModel, Field
 
-from servostudio.api.deps import Jobs, Live, current_user
+from servostudio.api.deps import Jobs, Live
 from servostudio.api.errors import error_responses
 from servostudio.api.routes.comm_models import JobModel, NodeIdentity
 from servostudio.api.routes.drives import DRIVE_ERRORS
 from servostudio.api.routes.project_models import ParameterList, ProjectModel, parameter_model, project_model
+from servostudio.api.security import Requires
+from servostudio.services.users import Level
 
-router = APIRouter(tags=["projects"], dependencies=[Depends(current_user)], responses=error_responses(*DRIVE_ERRORS))
+router = APIRouter(tags=["projects"], responses=error_responses(*DRIVE_ERRORS))
 
 
 class TakeRequest(BaseModel):
@@ -90,14 +92,20 @@ class ScanResultModel(BaseModel):
     project: ProjectModel
 
 
-@router.post("/projects/{name}/axes/{axis}/take-from-drive", response_model=ParameterList)
+@router.post(
+    "/projects/{name}/axes/{axis}/take-from-drive", response_model=ParameterList, dependencies=[Requires(Level.EXPERT)]
+)
 def take_from_drive(name: str, axis: str, body: TakeRequest, live: Live) -> ParameterList:
     """Store the drive's values in the project (checked like offline edits; all or nothing)."""
     change = live.take(name, axis, body.addresses, body.revision)
     return ParameterList(parameters=[parameter_model(row) for row in change.rows], revision=change.revision)
 
 
-@router.post("/projects/{name}/axes/{axis}/write-to-drive", response_model=DriveWriteReportModel)
+@router.post(
+    "/projects/{name}/axes/{axis}/write-to-drive",
+    response_model=DriveWriteReportModel,
+    dependencies=[Requires(Level.EXPERT)],
+)
 def write_to_drive(name: str, axis: str, body: WriteRequest, live: Live) -> DriveWriteReportModel:
     """Write the project's values to the drive; every value is checked like an online write before the first is
     sent, so one bad value writes nothing (422)."""
@@ -105,14 +113,19 @@ def write_to_drive(name: str, axis: str, body: WriteRequest, live: Live) -> Driv
     return DriveWriteReportModel.model_validate(report.as_dict())
 
 
-@router.post("/projects/{name}/commission", response_model=JobModel, status_code=status.HTTP_202_ACCEPTED)
+@router.post(
+    "/projects/{name}/commission",
+    response_model=JobModel,
+    status_code=status.HTTP_202_ACCEPTED,
+    dependencies=[Requires(Level.MAINTENANCE)],
+)
 def start_commission(name: str, body: CommissionRequest, live: Live, jobs: Jobs) -> dict:
     """Runs as a job: follow ``progress`` and ``job`` events on ``/api/ws/events`` or poll ``GET /api/jobs/{id}``;
     the result is the report per axis (status ok / bus_down / no_answer / wrong_device, files restored or read)."""
     return live.start_commission(jobs, name, body.direction, body.axes, body.revision).as_dict()
 
 
-@router.post("/projects/{name}/scan", response_model=ScanResultModel)
+@router.post("/projects/{name}/scan", response_model=ScanResultModel, dependencies=[Requires(Level.EXPERT)])
 def scan_into_project(name: str, body: ScanRequest, live: Live) -> ScanResultModel:
     """Scan a bus and add an axis for every identified node not yet in the project (one project change)."""
     report = live.scan(name, body.bus, body.bus_name, body.revision, body.create)

@@ -5,10 +5,14 @@ from __future__ import annotations
 import enum
 from collections.abc import Mapping
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
-from servostudio.drive.faults import FaultInfo
+from servostudio.drive.faults import CodedBits, FaultInfo, cia402_error_text
 from servostudio.errors import NotFound
 from servostudio.od.model import SaveType
+
+if TYPE_CHECKING:  # the recorder module builds on this one's ProfileError
+    from servostudio.drive.profiles.recorder import RecorderDescription
 
 #: Objects every CiA 301 device has, and those of a CiA 402 drive, by semantic name.
 CIA301_OBJECTS: dict[str, tuple[int, int]] = {
@@ -33,7 +37,45 @@ CIA402_OBJECTS: dict[str, tuple[int, int]] = {
     "modes_of_operation_display": (0x6061, 0),
     "position_actual": (0x6064, 0),
     "velocity_actual": (0x606C, 0),
+    "target_position": (0x607A, 0),
+    "target_velocity": (0x60FF, 0),
+    "target_torque": (0x6071, 0),
+    "vl_target_velocity": (0x6042, 0),
+    "max_profile_velocity": (0x607F, 0),
+    "profile_velocity": (0x6081, 0),
+    "end_velocity": (0x6082, 0),
+    "profile_acceleration": (0x6083, 0),
+    "profile_deceleration": (0x6084, 0),
+    "homing_speed_fast": (0x6099, 1),
+    "homing_speed_slow": (0x6099, 2),
+    "position_offset": (0x60B0, 0),
+    "velocity_offset": (0x60B1, 0),
+    "torque_offset": (0x60B2, 0),
+    "interpolation_data": (0x60C1, 1),
 }
+#: The CiA 402 objects that set an axis moving or change how it moves: the control word, the mode, the targets
+#: and offsets, the motion profile.  Only the axis's controller may write them (``services.motion``).
+CIA402_MOTION_OBJECTS: frozenset[str] = frozenset(
+    {
+        "controlword",
+        "modes_of_operation",
+        "target_position",
+        "target_velocity",
+        "target_torque",
+        "vl_target_velocity",
+        "max_profile_velocity",
+        "profile_velocity",
+        "end_velocity",
+        "profile_acceleration",
+        "profile_deceleration",
+        "homing_speed_fast",
+        "homing_speed_slow",
+        "position_offset",
+        "velocity_offset",
+        "torque_offset",
+        "interpolation_data",
+    }
+)
 
 
 class EmcyLayout(enum.StrEnum):
@@ -82,8 +124,18 @@ class DeviceProfile:
     warning_word: str | None = None
     errors: Mapping[int, FaultInfo] = field(default_factory=dict)
     warnings: Mapping[int, FaultInfo] = field(default_factory=dict)
+    #: bit fields of the error words that hold one code each (not one fault per bit), e.g. the CD1-k's power fault
+    coded_error_bits: tuple[CodedBits, ...] = ()
     #: EMCY error codes with a device-specific meaning
     emcy_codes: Mapping[int, FaultInfo] = field(default_factory=dict)
+    #: the manual's remedy for an error code it gives no text of its own (0x603F, EMCY): shown with the CiA name
+    error_code_remedy: str = ""
+    #: the manufacturer code of "a procedure failed", whose cause the tool looks for in ``procedure_inputs``
+    procedure_fault: int | None = None
+    #: procedure trigger (semantic name) → the objects it needs non-zero and in range (semantic names)
+    procedure_inputs: Mapping[str, tuple[str, ...]] = field(default_factory=dict)
+    #: mode of operation (0x6060 value) → the limits that keep the axis still when they are 0 (semantic names)
+    mode_limits: Mapping[int, tuple[str, ...]] = field(default_factory=dict)
     emcy_layout: EmcyLayout = EmcyLayout.UNUSED
     #: the drive refuses to store parameters unless its power stage is disabled
     save_needs_disabled: bool = False
@@ -92,6 +144,13 @@ class DeviceProfile:
     #: the sequence file is read through the sequence objects (XtrapulsPac)
     has_sequences: bool = False
     addressing: Addressing = Addressing()
+    #: objects (semantic names) that set the axis moving or change how it moves: the controller's alone
+    motion_objects: frozenset[str] = CIA402_MOTION_OBJECTS
+    #: procedures that turn the motor by themselves, even with the power stage off (phasing, auto-tuning):
+    #: semantic name of the trigger object → the signature that starts it
+    moving_procedures: Mapping[str, str] = field(default_factory=dict)
+    #: the in-drive oscilloscope recorder (XtrapulsPac); None: the drive has none
+    recorder: RecorderDescription | None = None
 
     def address(self, name: str) -> tuple[int, int]:
         try:
@@ -101,6 +160,14 @@ class DeviceProfile:
 
     def has(self, name: str) -> bool:
         return name in self.objects
+
+    def code_fault(self, code: int) -> FaultInfo | None:
+        """The fault an error code (0x603F, EMCY bytes 0-1) stands for: the device's own text, else the CiA 301/402
+        name with the manual's general remedy; None for code 0 (no error)."""
+        if not code:
+            return None
+        known = self.emcy_codes.get(code)
+        return known or FaultInfo(0, code, cia402_error_text(code).capitalize(), self.error_code_remedy)
 
     def signature(self, procedure: str) -> tuple[tuple[int, int], int]:
         """``((index, sub), value)`` to write to start a procedure such as "save"."""

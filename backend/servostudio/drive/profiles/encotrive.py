@@ -1,6 +1,9 @@
 """TR-Electronic encoTRive MD-025: standard CiA 301/402 objects; faults only as EMCY / 0x603F codes.
 
-Source: the encoTRive MD-025 manual, L429 (manual 004 in docs/devices.md): the manufacturer EMCY bytes are unused.
+Source: the *encoTRive MD-025 CANopen* user manual (manual 004 in docs/devices.md): the manufacturer EMCY bytes are
+unused (§ EMCY, p. 157); the error codes and their texts (pp. 253-260, Table 34 and the manufacturer table).  A
+code the manual gives no text of its own (0x2310 continuous over-current, …) is a CiA 301/402 code: it is shown by
+its standard name, with the manual's error register class and its general rule for acknowledging an error.
 """
 
 from __future__ import annotations
@@ -38,10 +41,31 @@ _EMCY = {
     )
 }
 
+#: what the manual says of every error (p. 253-254): the error register 1001h shows its class, 1003h its code
+_ACKNOWLEDGE = (
+    "The error register 1001h shows its class (bit 1 current, 2 voltage, 3 temperature, 4 communication) and 1003h "
+    "the history. Remove the cause, then acknowledge with control word bit 7: the drive goes to switch-on disabled."
+)
+
+#: positioning ramp (1) and speed ramp (3): each ramp and speed is limited by its maximum (Table 16, Table 19);
+#: a 0 in any of them keeps the axis still without a fault
+_RAMP_LIMITS = ("profile_acceleration", "max_acceleration", "profile_deceleration", "max_deceleration")
+
 ENCOTRIVE = DeviceProfile(
     device="encotrive",
-    objects={**CIA301_OBJECTS, **CIA402_OBJECTS, "error_history": (0x1003, 1)},
+    objects={
+        **CIA301_OBJECTS,
+        **CIA402_OBJECTS,
+        "error_history": (0x1003, 1),
+        "max_acceleration": (0x60C5, 0),
+        "max_deceleration": (0x60C6, 0),
+    },
     signatures={"save": ("store_parameters", "save"), "load": ("restore_parameters", "load")},
     emcy_codes=_EMCY,
+    error_code_remedy=_ACKNOWLEDGE,
     addressing=Addressing(reason="encoTRive node IDs are 1-127"),
+    mode_limits={
+        1: ("profile_velocity", "max_profile_velocity", *_RAMP_LIMITS),
+        3: ("max_profile_velocity", *_RAMP_LIMITS),
+    },
 )

@@ -15,7 +15,7 @@ from typing import Protocol
 
 import can
 
-from servostudio.drive.access import Drive
+from servostudio.drive.access import OPEN_GATE, Drive, WriteGate
 from servostudio.drive.link import BusLink
 from servostudio.drive.monitor import BusMonitor
 from servostudio.drive.nmt import NmtCommand, send_nmt
@@ -25,6 +25,7 @@ from servostudio.errors import Conflict, NotFound
 from servostudio.od.library import EdsLibrary, builtin_library
 from servostudio.services.bus.events import EventHub
 from servostudio.services.bus.statewatch import StatuswordWatch
+from servostudio.services.motion import MotionGuard
 from servostudio.transport.open import open_bus
 from servostudio.transport.spec import BusSpec, parse_bus_spec
 
@@ -75,6 +76,7 @@ class BusConnection:
     events: EventHub
     nodes: dict[int, NodeInfo] = field(default_factory=dict)
     simulation: Simulation | None = None  # the simulated drives of a ``sim`` bus, stopped with it
+    gate: WriteGate = OPEN_GATE  # every write of the bus's drives passes it: the manager's motion guard
     monitor: BusMonitor | None = None
     _identifying: dict[int, threading.Lock] = field(default_factory=dict, repr=False)
     _identifying_guard: threading.Lock = field(default_factory=threading.Lock, repr=False)
@@ -86,7 +88,7 @@ class BusConnection:
             raise UnknownBusOrNode(f"node ID {node} outside 1..127")
         device = device or self._device_of(node)
         dictionary = self.library.load(device) if device else None
-        return Drive(self.engine, node, dictionary, profile_for(device))
+        return Drive(self.engine, node, dictionary, profile_for(device), self.gate)
 
     def _device_of(self, node: int) -> str | None:
         """The node's device, identifying it first when unknown.
@@ -146,9 +148,13 @@ class BusConnection:
 class ConnectionManager:
     """All buses of the server (or of one CLI command)."""
 
-    def __init__(self, library: EdsLibrary | None = None, events: EventHub | None = None) -> None:
+    def __init__(
+        self, library: EdsLibrary | None = None, events: EventHub | None = None, motion: MotionGuard | None = None
+    ) -> None:
         self.library = library or builtin_library()
         self.events = events or EventHub()
+        #: every drive of every bus writes through it (one of its own unless the server shares one)
+        self.motion = motion if motion is not None else MotionGuard(self.events.publish)
         self._buses: dict[str, BusConnection] = {}
         self._lock = threading.Lock()
 
@@ -166,7 +172,14 @@ class ConnectionManager:
         link = BusLink(bus_id, opener)
         timeout = SERIAL_SDO_TIMEOUT if spec.kind == "serial" else CAN_SDO_TIMEOUT
         connection = BusConnection(
-            bus_id, spec, link, SdoEngine(link, timeout), self.library, self.events, simulation=simulation
+            bus_id,
+            spec,
+            link,
+            SdoEngine(link, timeout),
+            self.library,
+            self.events,
+            simulation=simulation,
+            gate=self.motion.gate(bus_id),
         )
         connection.monitor = BusMonitor(link, self.events.publish, connection.profile_of)
         StatuswordWatch(connection, lambda: self.events.wants("drive_state"))

@@ -12,8 +12,9 @@ others completed), ``failed`` (the work raised, or every unit failed) or ``cance
 
 from __future__ import annotations
 
-import itertools
+import contextvars
 import logging
+import secrets
 import threading
 import time
 from collections.abc import Callable
@@ -83,19 +84,20 @@ class JobRegistry:
     def __init__(self, events: EventHub) -> None:
         self.events = events
         self._jobs: dict[str, Job] = {}
-        self._numbers = itertools.count(1)
         self._lock = threading.Lock()
 
     def start(self, operation: str, work: Callable[[Progress, Cancellation], object]) -> Job:
         """Run ``work(progress, cancellation)`` in a thread; its return value (JSON-ready) becomes the job's
         result."""
-        job = Job(id=f"job{next(self._numbers)}", operation=operation)
+        job = Job(id=f"job-{secrets.token_hex(16)}", operation=operation)  # unguessable, unlike a counter
         with self._lock:
             self._jobs[job.id] = job
             for old in list(self._jobs)[:-KEEP_JOBS]:
                 del self._jobs[old]
 
-        threading.Thread(target=self._run, args=(job, work), name=job.id, daemon=True).start()
+        # the job acts for whoever started it (the motion guard and the audit log read it from the context)
+        starter = contextvars.copy_context()
+        threading.Thread(target=starter.run, args=(self._run, job, work), name=job.id, daemon=True).start()
         return job
 
     def _run(self, job: Job, work: Callable[[Progress, Cancellation], object]) -> None:
@@ -104,7 +106,9 @@ class JobRegistry:
 
         try:
             _record(job, work(progress, job.cancellation))
-        except Exception as error:  # noqa: BLE001 - the job reports any failure to its client; a bug is logged too
+        except Exception as error:  # the job reports any failure to its client; a bug is logged as well
+            if not isinstance(error, ServoStudioError):
+                log.exception("%s %s failed unexpectedly", job.operation, job.id)
             job.state, job.error = "failed", _reason(job, error)
         if job.cancellation.requested:
             job.state = "cancelled"
@@ -137,9 +141,8 @@ def _record(job: Job, outcome: object) -> None:
 
 
 def _reason(job: Job, error: Exception) -> str:
-    """The error a client sees; one outside the taxonomy is a bug, logged here, and its text (which may name
-    server paths) stays in the log."""
+    """The error a client sees; the text of one outside the taxonomy (a bug, which may name server paths) stays in
+    the log."""
     if isinstance(error, ServoStudioError):
         return str(error)
-    log.exception("%s %s failed unexpectedly", job.operation, job.id)
     return f"internal error in {job.operation} {job.id}; the server log has the details"

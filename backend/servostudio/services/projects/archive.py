@@ -2,11 +2,14 @@
 
 The zip holds one top-level directory named after the project with the project's files below it, members sorted,
 timestamps fixed, so archiving the same project twice gives the same bytes. Unpacking trusts nothing in the file:
-every member name is checked (no absolute path, no drive letter, no ``..``, no backslash), links and special files
-are refused, and the size of each member, of the total and the compression ratio are limited (zip bombs). The sizes
-checked are the ones the zip declares; ``zipfile`` never inflates a member beyond its declared size and fails on a
-CRC mismatch, so a zip lying about its sizes is refused as damaged. Everything is unpacked into a hidden staging
-directory and renamed into place only when all members passed, so a refused archive leaves no trace.
+every member name is checked as the archive spells it (no absolute path, no drive letter, no ``..``, no backslash,
+no NUL anywhere — ``zipfile`` would silently cut the name at a NUL), links and special files are refused, and the
+size of each member, of the total and the compression ratio are limited (zip bombs). The sizes checked are the
+ones the zip declares; ``zipfile`` never inflates a member beyond its declared size and fails on a CRC mismatch,
+so a zip lying about its sizes is refused as damaged. Everything is unpacked into a hidden staging
+directory and renamed into place only when all members passed — and when the project file and every axis file
+passed the editor's own rules (``verify``), ranges included — so a refused archive leaves no trace.  Messages name
+the archive by its file name only, never by a server path.
 """
 
 from __future__ import annotations
@@ -77,27 +80,29 @@ def unarchive_project(
     unchanged.
     """
     source = Path(source)
+    label = source.name  # what messages call the archive: its name, not where the server keeps it
     try:
         archive = zipfile.ZipFile(source)
     except (zipfile.BadZipFile, OSError) as error:
-        raise ArchiveError(f"{source}: not a readable zip archive ({error})") from None
+        reason = error.strerror if isinstance(error, OSError) else error
+        raise ArchiveError(f"{label}: not a readable zip archive ({reason})") from None
     with archive:
-        top = _check_members(archive, source, limits)
+        top = _check_members(archive, label, limits)
         name = check_name(new_name or top, "project")
         store.root.mkdir(parents=True, exist_ok=True)
         with store.staging() as staging:
-            _extract(archive, source, staging)
+            _extract(archive, label, staging)
             if not (staging / layout.PROJECT_FILE).is_file():
-                raise ArchiveError(f"{source}: no {top}/{layout.PROJECT_FILE} in the archive; not a project archive")
+                raise ArchiveError(f"{label}: no {top}/{layout.PROJECT_FILE} in the archive; not a project archive")
             try:
                 store.adopt(staging, name, rename=name != top, verify=verify)
             except FileFormatError as error:
                 member = f"{top}/{Path(error.file).relative_to(staging).as_posix()}"
-                raise ArchiveError(f"{source}: {member}:{error.line}: {error.reason}") from None
+                raise ArchiveError(f"{label}: {member}:{error.line}: {error.reason}") from None
     return store.open(name)
 
 
-def _check_members(archive: zipfile.ZipFile, source: Path, limits: ArchiveLimits) -> str:
+def _check_members(archive: zipfile.ZipFile, source: str, limits: ArchiveLimits) -> str:
     """Validate every member name and type; return the single top-level directory name."""
     members = archive.infolist()
     if not members:
@@ -106,7 +111,7 @@ def _check_members(archive: zipfile.ZipFile, source: Path, limits: ArchiveLimits
         raise ArchiveError(f"{source}: {len(members)} members, more than the limit of {limits.max_members}")
     tops = set()
     for info in members:
-        parts = _safe_parts(info.filename, source)
+        parts = _safe_parts(info, source)
         kind = stat.S_IFMT(info.external_attr >> 16)
         if kind == stat.S_IFLNK:
             raise ArchiveError(f"{source}: member '{info.filename}' is a symbolic link; links are not allowed")
@@ -136,9 +141,13 @@ def _check_members(archive: zipfile.ZipFile, source: Path, limits: ArchiveLimits
     return tops.pop()
 
 
-def _safe_parts(member: str, source: Path) -> tuple[str, ...]:
-    if "\\" in member or "\0" in member:
-        raise ArchiveError(f"{source}: member '{member}' contains a backslash or NUL in its name")
+def _safe_parts(info: zipfile.ZipInfo, source: str) -> tuple[str, ...]:
+    """The parts of a member's path; ``orig_filename`` is the name as stored (``filename`` is cut at a NUL)."""
+    member = info.filename
+    if "\0" in info.orig_filename:
+        raise ArchiveError(f"{source}: member {info.orig_filename!r} contains a NUL in its name")
+    if "\\" in member:
+        raise ArchiveError(f"{source}: member '{member}' contains a backslash in its name")
     path = PurePosixPath(member)
     if path.is_absolute() or (path.parts and ":" in path.parts[0]):
         raise ArchiveError(f"{source}: member '{member}' has an absolute path")
@@ -150,11 +159,11 @@ def _safe_parts(member: str, source: Path) -> tuple[str, ...]:
     return parts
 
 
-def _extract(archive: zipfile.ZipFile, source: Path, staging: Path) -> None:
+def _extract(archive: zipfile.ZipFile, source: str, staging: Path) -> None:
     """Copy the members; ``zipfile`` stops inflating at the declared size and fails on a CRC mismatch, so the
     checked sizes are the real ones."""
     for info in archive.infolist():
-        parts = _safe_parts(info.filename, source)[1:]
+        parts = _safe_parts(info, source)[1:]
         target = staging.joinpath(*parts) if parts else staging
         if info.is_dir():
             target.mkdir(parents=True, exist_ok=True)

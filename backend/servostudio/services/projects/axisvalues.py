@@ -60,13 +60,16 @@ class AxisValues:
     changed: set[str] = field(default_factory=set)
 
     @classmethod
-    def load(cls, directory: Path, dictionary: ObjectDictionary, node_id: int) -> AxisValues:
+    def load(cls, directory: Path, dictionary: ObjectDictionary, node_id: int, strict: bool = False) -> AxisValues:
+        """The axis's files parsed; each value must be of its object's type, and with ``strict`` (files from
+        outside, such as an archive) pass every rule of the editor, ranges included (`check_as_editor`)."""
         values = cls(dictionary, node_id)
+        check = values.check_as_editor if strict else values._check_entry
         for file_name in values.parameter_files:
             path = directory / file_name
             text = path.read_text(encoding=FILE_ENCODING) if path.is_file() else ""
             try:
-                entries = parse_object_file(text, str(path), values._check_entry)
+                entries = parse_object_file(text, str(path), check)
             except ObjectFileError as error:
                 raise FileFormatError(error.file, error.line, error.reason) from None
             values.files[file_name] = {(entry.index, entry.sub): entry for entry in entries}
@@ -153,6 +156,21 @@ class AxisValues:
         for file_name, text in texts.items():
             edit.write_axis_file(axis, file_name, text.encode(FILE_ENCODING))
         self.changed.clear()
+
+    def check_as_editor(self, entry: ObjectEntry) -> str | None:
+        """Why the editor would refuse this entry's value (`stage`: an object it may edit, a value of the object's
+        type within its range), or None; an object the dictionary does not know is kept, as the editor keeps it."""
+        variable = self.dictionary.get(entry.index, entry.sub)
+        if variable is None:
+            return None
+        reason = self.editable_reason(variable)
+        if reason is not None:
+            return reason
+        try:
+            variable.check(from_file_value(variable, entry.value))
+        except (BadValue, WrongType, OutOfRange) as error:
+            return str(error)
+        return None
 
     def _check_entry(self, entry: ObjectEntry) -> str | None:
         variable = self.dictionary.get(entry.index, entry.sub)

@@ -11,34 +11,15 @@ from __future__ import annotations
 import contextlib
 import fcntl
 import os
-import tempfile
 from collections.abc import Iterator
 from pathlib import Path
 
+from servostudio.formats.textfile import write_bytes_atomic
+
 
 def atomic_write(path: Path, data: bytes | str) -> None:
-    """Replace ``path`` with ``data`` in one step (temp file in the same directory, fsync, ``os.replace``)."""
-    payload = data.encode("utf-8") if isinstance(data, str) else data
-    handle, temp_name = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
-    try:
-        with os.fdopen(handle, "wb") as stream:
-            stream.write(payload)
-            stream.flush()
-            os.fsync(stream.fileno())
-        os.chmod(temp_name, _mode_of(path, 0o644))
-        os.replace(temp_name, path)
-    except BaseException:
-        with contextlib.suppress(FileNotFoundError):
-            os.unlink(temp_name)
-        raise
-
-
-def _mode_of(path: Path, default: int) -> int:
-    """Keep the permissions of the file being replaced (``mkstemp`` would leave 0600)."""
-    try:
-        return path.stat().st_mode & 0o7777
-    except FileNotFoundError:
-        return default
+    """Replace ``path`` with ``data`` (text as UTF-8) in one step: `write_bytes_atomic`."""
+    write_bytes_atomic(path, data.encode("utf-8") if isinstance(data, str) else data)
 
 
 @contextlib.contextmanager

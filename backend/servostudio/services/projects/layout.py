@@ -2,5 +2,6 @@
 
 PROJECT_FILE = "project.toml"
 SEQUENCE = "SEQUENCE.TXT"
+CAPTURES_DIR = "captures"  # <axis>/captures/NAME.csv + NAME.json: saved oscilloscope captures (docs/scope.md)
 USER_MOTORS_DIR = ".motors"  # user motor catalog inside the project store (names never start with '.')
 TEMP_PREFIX = "."  # temporary files and directories start with a dot and are never listed

@@ -7,17 +7,27 @@ from pathlib import Path
 
 from servostudio.formats.sequence import SequenceFileError, parse_sequence_text
 from servostudio.formats.textfile import FILE_ENCODING
+from servostudio.services.audit import AuditLog, ProjectAudit
+from servostudio.services.dictionaries import check_file
 from servostudio.services.projects import layout
 from servostudio.services.projects.archive import DEFAULT_LIMITS, ArchiveLimits, archive_project, unarchive_project
 from servostudio.services.projects.axisvalues import AxisValues
-from servostudio.services.projects.dcf import export_dcf
+from servostudio.services.projects.dcf import configured_values, export_dcf
 from servostudio.services.projects.errors import FileFormatError
 from servostudio.services.projects.model import Project
 from servostudio.services.projects.motors import BUILTIN_MOTORS_DIR, MotorCatalog
 from servostudio.services.projects.motorselect import apply_motor
 from servostudio.services.projects.parameters import DictionaryLibrary, ParameterChange, ParameterService, parameter_row
-from servostudio.services.projects.store import ProjectStore, Snapshot
+from servostudio.services.projects.store import UNRECORDED, ProjectStore, Snapshot
 from servostudio.services.projects.templates import ApplicationTemplate, template
+
+
+@dataclass(frozen=True)
+class DcfImport:
+    """Result of a DCF import: the objects set, and the configured values the project cannot hold (and why)."""
+
+    change: ParameterChange
+    skipped: list[str]
 
 
 @dataclass(frozen=True)
@@ -30,8 +40,14 @@ class AxisChoice:
 
 
 class ProjectService:
-    def __init__(self, root: Path, library: DictionaryLibrary, motors_dir: Path = BUILTIN_MOTORS_DIR) -> None:
-        self.store = ProjectStore(root, library)
+    def __init__(
+        self,
+        root: Path,
+        library: DictionaryLibrary,
+        motors_dir: Path = BUILTIN_MOTORS_DIR,
+        audit: AuditLog | None = None,
+    ) -> None:
+        self.store = ProjectStore(root, library, ProjectAudit(audit) if audit is not None else UNRECORDED)
         self.library = library
         self.parameters = ParameterService(self.store, library)
         self.motors = MotorCatalog(motors_dir, Path(root) / layout.USER_MOTORS_DIR)
@@ -73,6 +89,19 @@ class ProjectService:
             eds_text = values.dictionary.source.read_text(encoding="latin-1")
             return export_dcf(eds_text, view.project, chosen, values)
 
+    def import_dcf(self, project: str, axis: str, dcf: Path, expected_revision: str | None = None) -> DcfImport:
+        """Set the axis's offline values to what a DCF configures (all or nothing, checked as offline edits); the
+        configured values the project cannot hold are listed in the result."""
+        configuration = check_file(dcf)
+        with self.store.edit(project, expected_revision) as edit:
+            values = self.parameters.axis_values(edit, axis)
+            configured = configured_values(configuration, values)
+            for variable, value in configured.values:
+                values.stage(variable, value)
+            values.commit(edit, axis)
+        rows = [parameter_row(values, variable) for variable, _ in configured.values]
+        return DcfImport(ParameterChange(rows, edit.revision), configured.skipped)
+
     def archive(self, project: str, destination: Path) -> Path:
         return archive_project(self.store, project, destination)
 
@@ -80,11 +109,11 @@ class ProjectService:
         return unarchive_project(self.store, source, new_name, limits, verify=self.check_axis_files)
 
     def check_axis_files(self, directory: Path, project: Project) -> None:
-        """Parse every axis's object files against its dictionary and its SEQUENCE.TXT; raise
+        """Check every axis's object files by the editor's rules (ranges included) and its SEQUENCE.TXT; raise
         :class:`FileFormatError` naming the first bad file and line."""
         for axis in project.axes:
             axis_directory = directory / axis.name
-            AxisValues.load(axis_directory, self.parameters.dictionary(axis), axis.node_id)
+            AxisValues.load(axis_directory, self.parameters.dictionary(axis), axis.node_id, strict=True)
             sequence = axis_directory / layout.SEQUENCE
             if sequence.is_file():
                 try:

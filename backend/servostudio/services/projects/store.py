@@ -9,6 +9,11 @@ Concurrency: operations on one project hold an exclusive ``flock`` on the projec
 rename or remove project directories also hold one on the root. A change names the revision the caller last saw
 (``expected_revision``); if the project changed since, :class:`ConflictError` is raised and nothing is written.
 The revision is a hash of the project's files, so it costs nothing in git and follows edits made outside the tool.
+
+Crashes: every write is atomic (a temporary file renamed into place, a staging directory renamed into place), so a
+process killed mid-save leaves the old or the new file and, at most, its temporary; `remove_stale_temporaries`
+(at server start) removes those under the lock their writers hold.  Messages name projects, axes and files by
+their place in the store, never by a server path.
 """
 
 from __future__ import annotations
@@ -16,10 +21,12 @@ from __future__ import annotations
 import contextlib
 import hashlib
 import os
+import re
 import shutil
 import tempfile
+import time
 from collections.abc import Callable, Iterator
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, fields, replace
 from pathlib import Path
 from typing import Any, Protocol
 
@@ -36,11 +43,38 @@ from servostudio.services.projects.model import Axis, Bus, Project, from_text, t
 from servostudio.services.projects.names import check_name, is_valid_name, same_name
 from servostudio.services.projects.validation import validate_project
 
+#: what interrupted writes leave: an atomic write's temporary file, a staging directory, a trash directory
+_TEMPORARY = re.compile(r"\.(?:.+\.tmp|new-.+|deleted-.+)", re.DOTALL)
+#: an archive is unpacked into a staging directory of the root without the store lock: one younger than this may
+#: still be in use by another process
+STAGING_GRACE = 60.0
+
 
 class DeviceCatalog(Protocol):
     """What the store needs from the EDS library: the device keys it may reference."""
 
     def devices(self) -> list[str]: ...
+
+
+class ProjectJournal(Protocol):
+    """Who is told what each change wrote: the audit log (``services.audit.ProjectAudit``)."""
+
+    def axis_file(self, project: str, axis: str, file_name: str, old: bytes, new: bytes) -> None: ...
+
+    def project(self, project: str, what: str) -> None: ...
+
+
+class _Unrecorded:
+    """A store nobody audits (tools and tests that build one on its own)."""
+
+    def axis_file(self, project: str, axis: str, file_name: str, old: bytes, new: bytes) -> None:
+        return None
+
+    def project(self, project: str, what: str) -> None:
+        return None
+
+
+UNRECORDED: ProjectJournal = _Unrecorded()
 
 
 @dataclass(frozen=True)
@@ -54,10 +88,11 @@ class Snapshot:
 class ProjectEdit:
     """A project opened for change inside :meth:`ProjectStore.edit`; writes go straight to disk, atomically."""
 
-    def __init__(self, directory: Path, project: Project) -> None:
+    def __init__(self, directory: Path, project: Project, journal: ProjectJournal = UNRECORDED) -> None:
         self.directory = directory
         self.project = project
         self.revision = ""
+        self.journal = journal
 
     def axis(self, name: str) -> Axis:
         axis = self.project.axis(name)
@@ -72,17 +107,28 @@ class ProjectEdit:
     def write_axis_file(self, axis: str, file_name: str, data: bytes) -> None:
         directory = self.axis_directory(axis)
         directory.mkdir(exist_ok=True)
-        atomic_write(directory / file_name, data)
+        path = directory / file_name
+        old = path.read_bytes() if path.is_file() else b""
+        atomic_write(path, data)
+        self.journal.axis_file(self.project.name, axis, file_name, old, data)
 
     def save(self, project: Project) -> None:
         atomic_write(self.directory / layout.PROJECT_FILE, to_text(project))
+        self.journal.project(self.project.name, f"project file saved ({_changes(self.project, project)})")
         self.project = project
 
 
+def _changes(old: Project, new: Project) -> str:
+    """Which fields of the project file a save changed, for the journal."""
+    changed = [item.name for item in fields(Project) if getattr(old, item.name) != getattr(new, item.name)]
+    return ", ".join(changed) or "unchanged"
+
+
 class ProjectStore:
-    def __init__(self, root: Path, devices: DeviceCatalog) -> None:
+    def __init__(self, root: Path, devices: DeviceCatalog, journal: ProjectJournal = UNRECORDED) -> None:
         self.root = Path(root)
         self._devices = devices
+        self.journal = journal
 
     # ---- projects -------------------------------------------------------------------------------------------
 
@@ -111,6 +157,7 @@ class ProjectStore:
             with self.staging() as staging:
                 atomic_write(staging / layout.PROJECT_FILE, to_text(project))
                 os.rename(staging, self.root / name)
+            self.journal.project(name, "created")
             return Snapshot(project, revision_of(self.root / name))
 
     def update(
@@ -151,6 +198,7 @@ class ProjectStore:
                 copy = replace(self._read(source), name=new_name)
                 atomic_write(staging / layout.PROJECT_FILE, to_text(copy))
                 os.rename(staging, self.root / new_name)
+            self.journal.project(new_name, f"created as a copy of '{name}'")
             return Snapshot(copy, revision_of(self.root / new_name))
 
     def delete(self, name: str, expected_revision: str | None = None) -> None:
@@ -158,6 +206,7 @@ class ProjectStore:
             trash = Path(tempfile.mkdtemp(dir=self.root, prefix=".deleted-"))
             os.rename(edit.directory, trash / name)
             edit.directory = trash / name
+            self.journal.project(name, "deleted")
         shutil.rmtree(trash)
 
     # ---- axes -----------------------------------------------------------------------------------------------
@@ -177,7 +226,7 @@ class ProjectStore:
                 directory = edit.directory / axis.name
                 if directory.exists():
                     raise ProjectExists(
-                        f"'{directory}' already exists but is not an axis of project '{name}';"
+                        f"'{name}/{axis.name}' already exists but is not an axis of project '{name}';"
                         " move it away or choose another axis name"
                     )
             for axis in axes:
@@ -201,7 +250,7 @@ class ProjectStore:
             self._validate(changed)
             moving = new.name != old.name and (edit.directory / old.name).is_dir()
             if moving and (edit.directory / new.name).exists() and not same_name(old.name, new.name):
-                raise ProjectExists(f"'{edit.directory / new.name}' already exists; choose another axis name")
+                raise ProjectExists(f"'{project}/{new.name}' already exists; choose another axis name")
             if new.device != old.device:
                 _switch_device_files(edit.directory / old.name, old, new.device)
             if moving:
@@ -235,7 +284,7 @@ class ProjectStore:
                 actual = revision_of(directory)
                 if actual != expected_revision:
                     raise ConflictError(name, expected_revision, actual)
-            edit = ProjectEdit(directory, self._read(directory))
+            edit = ProjectEdit(directory, self._read(directory), self.journal)
             yield edit
             edit.revision = revision_of(edit.directory)
 
@@ -255,7 +304,7 @@ class ProjectStore:
     def _store_lock(self) -> Iterator[None]:
         """Exclusive lock on the store directory, for operations that add, rename or remove project directories."""
         if not self.root.is_dir():
-            raise ProjectNotFound(f"the project store {self.root} does not exist")
+            raise ProjectNotFound("the project store does not exist")
         with locked_directory(self.root):
             yield
 
@@ -263,7 +312,7 @@ class ProjectStore:
     def _project_lock(self, name: str, exclusive: bool) -> Iterator[Path]:
         directory = self.project_directory(name)
         if not (directory / layout.PROJECT_FILE).is_file():
-            raise ProjectNotFound(f"no project '{name}' in {self.root}")
+            raise ProjectNotFound(f"no project '{name}' in the project store")
         with locked_directory(directory, exclusive) as locked:
             if not is_same_directory(locked, directory):
                 raise ProjectNotFound(f"project '{name}' was renamed or deleted meanwhile")
@@ -297,6 +346,21 @@ class ProjectStore:
             if rename:
                 atomic_write(directory / layout.PROJECT_FILE, to_text(project))
             os.rename(directory, self.root / name)
+            self.journal.project(name, "imported from an archive")
+
+    def remove_stale_temporaries(self) -> int:
+        """Remove what interrupted saves left in the store (the server does at start) and say how many entries went.
+
+        Each project is cleaned under its exclusive lock and the root under the store lock — the locks their writers
+        hold — so a save in progress in another process is never touched."""
+        if not self.root.is_dir():
+            return 0
+        with locked_directory(self.root):
+            removed = _remove_temporaries(self.root, STAGING_GRACE, recurse=False)
+        for name in self.names():
+            with contextlib.suppress(ProjectNotFound), self._project_lock(name, exclusive=True) as directory:
+                removed += _remove_temporaries(directory)
+        return removed
 
     def _read(self, directory: Path) -> Project:
         path = directory / layout.PROJECT_FILE
@@ -308,7 +372,7 @@ class ProjectStore:
     def _refuse_existing(self, name: str) -> None:
         for existing in self.root.iterdir():
             if same_name(existing.name, name):
-                raise ProjectExists(f"'{existing}' already exists; choose another project name")
+                raise ProjectExists(f"'{existing.name}' already exists in the project store; choose another name")
 
 
 def _switch_device_files(directory: Path, axis: Axis, device: str) -> None:
@@ -318,8 +382,7 @@ def _switch_device_files(directory: Path, axis: Axis, device: str) -> None:
     files = [path for path in directory.iterdir() if path.is_file() and not path.name.startswith(layout.TEMP_PREFIX)]
     if any(path.stat().st_size for path in files):
         raise ValidationError(
-            f"axis '{axis.name}' holds values for device '{axis.device}' in {directory}; "
-            "add a new axis for the other device instead"
+            f"axis '{axis.name}' holds values for device '{axis.device}'; add a new axis for the other device instead"
         )
     wanted = axis_files(device)
     for path in files:
@@ -331,10 +394,15 @@ def _switch_device_files(directory: Path, axis: Axis, device: str) -> None:
 
 
 def revision_of(directory: Path) -> str:
-    """Hash of every file of the project (paths and contents): changes whenever anything in the project changes."""
+    """Hash of every file of the project (paths and contents): changes whenever anything in the project changes.
+
+    Saved oscilloscope captures (``<axis>/captures/``) are recordings, not settings: saving one must not make
+    another client's next parameter change a conflict, so they are left out (they are still archived)."""
     digest = hashlib.sha256()
     for path in sorted(_project_files(directory)):
         relative = path.relative_to(directory).as_posix()
+        if relative.split("/")[1:2] == [layout.CAPTURES_DIR]:
+            continue
         digest.update(relative.encode() + b"\0" + path.read_bytes() + b"\0")
     return digest.hexdigest()[:16]
 
@@ -347,6 +415,28 @@ def _project_files(directory: Path) -> Iterator[Path]:
             path = Path(current) / file_name
             if not file_name.startswith(layout.TEMP_PREFIX) and not path.is_symlink() and path.is_file():
                 yield path
+
+
+def _remove_temporaries(directory: Path, min_age: float = 0.0, recurse: bool = True) -> int:
+    """Remove the temporaries directly in ``directory`` older than ``min_age`` s (and, with ``recurse``, those of its
+    subdirectories: the axes)."""
+    removed = 0
+    for entry in list(directory.iterdir()):
+        if entry.is_symlink():
+            continue
+        if _TEMPORARY.fullmatch(entry.name) and time.time() - entry.lstat().st_mtime >= min_age:
+            _remove(entry)
+            removed += 1
+        elif recurse and entry.is_dir() and not entry.name.startswith(layout.TEMP_PREFIX):
+            removed += _remove_temporaries(entry)
+    return removed
+
+
+def _remove(entry: Path) -> None:
+    if entry.is_dir():
+        shutil.rmtree(entry, ignore_errors=True)
+    else:
+        entry.unlink(missing_ok=True)
 
 
 def _ignore_temporary(_directory: str, names: list[str]) -> list[str]:

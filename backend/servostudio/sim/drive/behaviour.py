@@ -17,7 +17,16 @@ from typing import Any, Protocol
 from servostudio.sim.clock import CONTROL_PERIOD
 from servostudio.sim.drive import errors, gains
 from servostudio.sim.drive.commissioning import commissioned_values, current_limits
-from servostudio.sim.drive.device_map import MODE_HM, MODE_IP, MODE_PP, MODE_PT, MODE_PV, XTRAPULSPAC, DeviceProfile
+from servostudio.sim.drive.device_map import (
+    MODE_HM,
+    MODE_IP,
+    MODE_PP,
+    MODE_PT,
+    MODE_PV,
+    MODE_SQ,
+    XTRAPULSPAC,
+    DeviceProfile,
+)
 from servostudio.sim.drive.errors import DriveError
 from servostudio.sim.drive.loops import (
     MODE_OFF,
@@ -43,6 +52,7 @@ from servostudio.sim.drive.procedures import ABORTED, FAILED
 from servostudio.sim.drive.protection import I2tProtection
 from servostudio.sim.drive.recorder import Recorder
 from servostudio.sim.drive.runner import ProcedureRunner
+from servostudio.sim.drive.sequencer import SequenceMode
 from servostudio.sim.drive.statemachine import (
     STATE_BITS,
     STOP_CURRENT_LIMIT,
@@ -155,6 +165,9 @@ class DriveBehaviour:
         self._register_hooks()
         self.procedures = ProcedureRunner(self)
         self.recorder = Recorder.for_store(store)
+        self.sequencer = SequenceMode.for_drive(self)
+        if self.sequencer is not None:
+            self.handlers[MODE_SQ] = self.sequencer
         self.write("supported_modes", profile.supported_modes_word)
         self.refresh_parameters()
         self.device_control.initialised()
@@ -442,6 +455,8 @@ class DriveBehaviour:
         self.physics.power_cycle_sensor()
         if self.recorder is not None:
             self.recorder.reset()
+        if self.sequencer is not None:
+            self.sequencer.on_nmt_reset()
         self.loops.measure()
         if self.plant.feedback == FEEDBACK_ENCODER:
             self.phasing_valid = False
@@ -549,12 +564,11 @@ class DriveBehaviour:
         if not (self.negative_limit or self.positive_limit):
             return
         loops = self.loops
-        if self.active_mode == MODE_HM or loops.mode != MODE_POSITION:
+        handler = self._active_handler
+        if handler is None or handler.uses_limit_switches or loops.mode != MODE_POSITION:
             return
         if self.limit_blocks(loops.velocity_ff):
-            handler = self._active_handler
-            if isinstance(handler, ProfilePosition):
-                handler.limit_switch_stop()
+            handler.limit_switch_stop()
             loops.position_ref = loops.position
             loops.velocity_ff = loops.accel_ff = 0.0
 
@@ -612,9 +626,9 @@ class DriveBehaviour:
             limit = min(limit, self.rated_current)
         if self.device_control.stop_type == STOP_CURRENT_LIMIT:
             limit = min(limit, self.stop_current())
-        homing = self._active_handler
-        if isinstance(homing, HomingMode) and homing.uses_current_limit:
-            limit = min(limit, self.homing_current())
+        handler = self._active_handler
+        if handler is not None:
+            limit = min(limit, handler.current_limit())
         return limit
 
     def stop_current(self) -> float:
@@ -796,9 +810,8 @@ class DriveBehaviour:
 
     # -- homing support -----------------------------------------------------------------------------------------
 
-    def set_home(self, home_rad: float) -> None:
-        """Make the position at `home_rad` read as the home offset 0x607C from now on."""
-        offset = float(self.p.get("home_offset", 0))
+    def set_home(self, home_rad: float, offset: float) -> None:
+        """Make the position at `home_rad` read as the home offset (0x607C, or a HOME sequence's) from now on."""
         self.position_offset_user = offset - self.units.to_user(home_rad)
 
     def index_position_rad(self) -> float:
@@ -915,8 +928,8 @@ class DriveBehaviour:
                 status |= BIT_TARGET_REACHED
         elif device_control.state is State.OPERATION_ENABLED and handler is not None:
             status |= handler.status_bits()
-        elif isinstance(handler, HomingMode):
-            status |= handler.status_bits() & (1 << 13)
+        elif handler is not None:
+            status |= handler.not_following()
         return status | self._linked_bits
 
     def _linked_status_bits(self) -> int:

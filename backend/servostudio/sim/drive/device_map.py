@@ -16,6 +16,8 @@ MODE_PV = 3
 MODE_PT = 4
 MODE_HM = 6
 MODE_IP = 7
+MODE_SQ = -3
+"""XtrapulsPac sequence mode (docs/sequences.md)."""
 
 
 @dataclass(frozen=True)
@@ -186,7 +188,7 @@ XTRAPULSPAC = DeviceProfile(
         "tuning_requirement": (0x3425, 4),
         "device_status": (0x3441, 0),
     },
-    modes=frozenset({1, 3, 4, 6, 7}),
+    modes=frozenset({1, 3, 4, 6, 7, MODE_SQ}),
     procedures={
         "calc": (0x3411, 0),
         "clim": (0x3412, 0),

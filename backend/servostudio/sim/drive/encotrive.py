@@ -33,12 +33,32 @@ ENCOTRIVE = DeviceProfile(
 )
 
 
+#: Factory values where the encotrive.eds has no DefaultValue because the manual's excerpt cuts them off
+#: (docs/devices.md §12): 6083h prints as "400…", read as 4000 rpm/s; 6084h as the manual's commissioning example
+#: writes it (12000, p. 249); 60C5h as the printed 60C6h (15000); 607Fh as the printed 6081h (4400 rpm), so the
+#: default profile velocity is reachable.  The manual's visible ones (6081h 4400, 6085h 9000, 60C6h 15000) are the
+#: dictionary's.  A drive with a 0 in any of them would not move in positioning or speed ramp mode.
+FACTORY_VALUES: dict[tuple[int, int], int] = {
+    (0x607F, 0): 4400,
+    (0x6083, 0): 4000,
+    (0x6084, 0): 12000,
+    (0x60C5, 0): 15000,
+}
+
+
 class EncoTriveBehaviour(DriveBehaviour):
     def __init__(self, *args: Any, **kwargs: Any) -> None:
         super().__init__(*args, **kwargs)
         address = self.profile.address("position_actual")
         if address is not None and address in self.store:
             self.store.on_write(address[0], address[1], self._preset_position)
+
+    def set_hardware_data(self) -> None:
+        """The manual's ramps and speed limits where the dictionary leaves them open, then the common values."""
+        for (index, sub), value in FACTORY_VALUES.items():
+            if (index, sub) in self.store and self.store.od[index, sub].default_for(self.store.node_id) is None:
+                self.store.set_factory(index, sub, value)
+        super().set_hardware_data()
 
     def _preset_position(self, index: int, sub: int, value: Any) -> None:
         """Writing 0x6064 sets the current position to `value` (absolute system preset)."""

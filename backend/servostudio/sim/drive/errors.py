@@ -37,6 +37,9 @@ SOFTWARE_LIMIT = DriveError(36, "Software position limit", 0x8680)
 MOTOR_TEMPERATURE = DriveError(37, "Motor temperature error", 0x4290)
 I2T = DriveError(38, "I2t error", 0x2350)
 BUSY_TIMEOUT = DriveError(40, "Busy / operation timeout", 0xFFA0)
+DRIVE_PARAMETERS_FILE = DriveError(42, "Drive parameters file error", 0x6320)
+USER_PARAMETERS_FILE = DriveError(43, "User parameters / template file error", 0x6320)
+SEQUENCE_FILE = DriveError(44, "Sequence file error", 0x6320)
 SYNC_CYCLE = DriveError(49, "Fieldbus SYNC cycle error", 0x8780)
 IP_UNDERFLOW = DriveError(50, "Fieldbus IP reference underflow/overflow", 0x8782)
 GUARDING = DriveError(51, "Fieldbus guarding error", 0x8130)
@@ -57,6 +60,9 @@ CATALOGUE: dict[int, DriveError] = {
         MOTOR_TEMPERATURE,
         I2T,
         BUSY_TIMEOUT,
+        DRIVE_PARAMETERS_FILE,
+        USER_PARAMETERS_FILE,
+        SEQUENCE_FILE,
         SYNC_CYCLE,
         IP_UNDERFLOW,
         GUARDING,

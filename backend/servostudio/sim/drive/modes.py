@@ -47,6 +47,23 @@ class ModeHandler:
     def status_bits(self) -> int:
         return 0
 
+    def not_following(self) -> int:
+        """The drive does not follow the mode's set-points (any state but Operation Enabled; called with every
+        status word update there): the status bits the mode still shows."""
+        return 0
+
+    @property
+    def uses_limit_switches(self) -> bool:
+        """True while the mode itself runs into the limit switches (homing): the drive then does not stop it there."""
+        return False
+
+    def limit_switch_stop(self) -> None:
+        """A limit switch in the direction of travel stopped the motion: drop what the generator was doing."""
+
+    def current_limit(self) -> float:
+        """The mode's own current limit (A) below the drive's: none, except where a mode pushes at a limit."""
+        return math.inf
+
 
 class ProfilePosition(ModeHandler):
     """PP: set-point handshake (CW4 ↑ → SW12), change immediately (CW5), relative (CW6), one buffered set-point,
@@ -294,25 +311,37 @@ class HomingMode(ModeHandler):
         self.homing = None
         self._final_move = False
 
+    def setting(self, name: str, default: float) -> float:
+        """A homing parameter by its profile name (a HOME sequence gives its own instead of 0x6098 …)."""
+        return float(self.drive.p.get(name, default))
+
     def control_word(self, control_word: int, previous: int) -> None:
-        drive = self.drive
         if control_word & CW_NEW_SET_POINT and not previous & CW_NEW_SET_POINT:
-            method = int(drive.p.get("homing_method", 35))
-            self.attained = False
-            self.error = False
-            if not drive.device_control.follows_set_points and method != 35:
-                self.error = True
-                return
-            self.homing = Homing(method)
-            self.error = self.homing.status is HomingStatus.ERROR
-            self._final_move = False
-            self._stall_time = 0.0
-            self.position_ref = drive.loops.position
-            if method == 35 and not drive.device_control.follows_set_points:
-                self._step_homing()
+            self.start()
         elif not control_word & CW_NEW_SET_POINT and previous & CW_NEW_SET_POINT:
-            self.homing = None
-            self._final_move = False
+            self.interrupt()
+
+    def interrupt(self) -> None:
+        """Drop the running method (CW4 = 0, or a HOME sequence ended early): the axis ramps to a stop."""
+        self.homing = None
+        self._final_move = False
+
+    def start(self) -> None:
+        """Start the homing method (CW4 rising edge, or a HOME sequence)."""
+        drive = self.drive
+        method = int(self.setting("homing_method", 35))
+        self.attained = False
+        self.error = False
+        if not drive.device_control.follows_set_points and method != 35:
+            self.error = True
+            return
+        self.homing = Homing(method)
+        self.error = self.homing.status is HomingStatus.ERROR
+        self._final_move = False
+        self._stall_time = 0.0
+        self.position_ref = drive.loops.position
+        if method == 35 and not drive.device_control.follows_set_points:
+            self._step_homing()
 
     def step(self) -> None:
         drive = self.drive
@@ -338,7 +367,7 @@ class HomingMode(ModeHandler):
     def _step_homing(self) -> float:
         drive = self.drive
         homing = self.homing
-        accel = drive.units.accel_to_rad(float(drive.p.get("homing_acceleration", 0))) or 1.0
+        accel = drive.units.accel_to_rad(self.setting("homing_acceleration", 0)) or 1.0
         if homing is None or homing.status is not HomingStatus.RUNNING:
             return self.ramp.step(0.0, accel, accel)
         return self._follow_homing(homing, self._homing_move(homing), accel)
@@ -382,17 +411,17 @@ class HomingMode(ModeHandler):
             return self.ramp.step(0.0, accel, accel)
         direction, speed_class = move
         name = "homing_speed_fast" if speed_class == FAST else "homing_speed_slow"
-        speed = min(drive.units.speed_to_rad(float(drive.p.get(name, 0))), drive.max_speed)
+        speed = min(drive.units.speed_to_rad(self.setting(name, 0)), drive.max_speed)
         return self.ramp.step(direction * speed, accel, accel)
 
     def _found(self, home_rad: float) -> None:
         drive = self.drive
-        drive.set_home(home_rad)
+        drive.set_home(home_rad, self.setting("home_offset", 0))
         drive.write("homing_indicator", 1)
-        if int(drive.p.get("end_on_home", 1)) and drive.device_control.follows_set_points:
+        if int(self.setting("end_on_home", 1)) and drive.device_control.follows_set_points:
             units = drive.units
-            speed = units.speed_to_rad(float(drive.p.get("homing_speed_slow", 0))) or 1.0
-            accel = units.accel_to_rad(float(drive.p.get("homing_acceleration", 0))) or 1.0
+            speed = units.speed_to_rad(self.setting("homing_speed_slow", 0)) or 1.0
+            accel = units.accel_to_rad(self.setting("homing_acceleration", 0)) or 1.0
             self.final.reset(self.position_ref)
             self.final.velocity = self.ramp.velocity
             self.final.move_to(home_rad, max(speed, abs(self.ramp.velocity)), accel, accel)
@@ -404,6 +433,18 @@ class HomingMode(ModeHandler):
     @property
     def uses_current_limit(self) -> bool:
         return self.homing is not None and self.homing.status is HomingStatus.RUNNING and self.homing.uses_current_limit
+
+    @property
+    def uses_limit_switches(self) -> bool:
+        return True
+
+    def current_limit(self) -> float:
+        """Methods −1..−4 push at the hard stop with the homing current limit."""
+        return self.drive.homing_current() if self.uses_current_limit else math.inf
+
+    def not_following(self) -> int:
+        """A homing error stays visible (SW13) while the drive is disabled."""
+        return self.status_bits() & BIT_13
 
     def status_bits(self) -> int:
         if self.error:

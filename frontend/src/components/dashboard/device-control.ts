@@ -38,6 +38,8 @@ export interface DeviceControlProps {
   reachable: State<boolean>;
   /** A command is under way: the transition buttons wait. */
   busy: State<boolean>;
+  /** This page armed the axis (docs/motion-safety.md): Enable operation waits for it. */
+  armed: Bindable<boolean>;
   /** `NMT <state>` */
   nmt: State<string>;
   /** The live data's connection (`live · every 200 ms`, `reconnecting…`). */
@@ -92,13 +94,17 @@ function transitionButtons(props: DeviceControlProps, driveState: State<DriveSta
     }
     const allowed = allowedTransitions(state);
     if (allowed.length === 0) return h("span", { class: "muted" }, "No transition can be commanded in this state.");
-    return untrack(() => allowed.map((transition) => h("button", {
-      class: transition.command === "enable_operation" ? "primary"
-        : transition.command === "quick_stop" || transition.command === "disable_voltage" ? "danger" : "",
-      disabled: props.busy, "data-testid": `transition-${transition.command}`,
-      title: `Transition ${transition.number}: ${STATE_LABELS[state]} → ${STATE_LABELS[transition.target]}`,
-      onclick: () => props.onCommand(transition.command),
-    }, COMMAND_LABELS[transition.command])));
+    return untrack(() => allowed.map((transition) => {
+      const enabling = transition.command === "enable_operation";
+      const title = `Transition ${transition.number}: ${STATE_LABELS[state]} → ${STATE_LABELS[transition.target]}`;
+      return h("button", {
+        class: enabling ? "primary" : transition.command === "quick_stop" || transition.command === "disable_voltage" ? "danger" : "",
+        disabled: () => props.busy.val || (enabling && !valueOf(props.armed)),
+        "data-testid": `transition-${transition.command}`,
+        title: () => (enabling && !valueOf(props.armed) ? "Arm the axis first (Controller): motion needs an armed controller" : title),
+        onclick: () => props.onCommand(transition.command),
+      }, COMMAND_LABELS[transition.command]);
+    }));
   });
 }
 

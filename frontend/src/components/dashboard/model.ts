@@ -6,9 +6,10 @@
  */
 
 import { projectAddress } from "../../client/api";
+import { controlApi, heldByMe, type AxisControl } from "../../client/control";
 import { driveApi, serverBus, type FaultReport, type ObjectValue } from "../../client/drives";
 import { TerminalSocket, type WatchRow } from "../../client/terminal-socket";
-import { errorText, toast } from "../ui";
+import { confirmAction, errorText, toast } from "../ui";
 import { COMMAND_LABELS, type Command } from "../../lib/cia402";
 import { PROFILE_VELOCITY_MODE, type DashboardSignals } from "../../lib/dashboard-objects";
 import { Scope, batch, derive, state, type State } from "../../lib/dom";
@@ -45,6 +46,10 @@ export class DashboardModel {
   readonly connection = state("");
   readonly message = state<DashboardMessage | null>(null);
   readonly faults = state<FaultReport | string | null>(null);
+  /** Who holds the axis (docs/motion-safety.md); null until the server answered. */
+  readonly control = state<AxisControl | null>(null);
+  /** Who asked this page, the controller, for the axis. */
+  readonly askedBy = state<string | null>(null);
   /** False once the first answer came and the live hub says the drive is offline. */
   readonly reachable: State<boolean>;
   private readonly answered = state(false);
@@ -73,6 +78,15 @@ export class DashboardModel {
     scope.add(live.on("emcy", (event) => {
       if (this.isOurs(event)) void this.refreshFaults();
     }));
+    scope.add(live.on("control", (event) => {
+      if (!this.isOurs(event)) return;
+      this.control.val = { bus: event.bus, node: event.node, holder: event.holder, requests: event.requests };
+      if (!heldByMe(this.control.rawVal)) this.askedBy.val = null;
+    }));
+    scope.add(live.on("control_request", (event) => {
+      if (this.isOurs(event)) this.askedBy.val = event.from.user;
+    }));
+    scope.add(live.on("ws_open", () => void this.refreshControl()));
     this.terminal.onRows = (rows) => this.onRows(rows);
     this.terminal.onError = (text) => (this.message.val = { kind: "error", text });
     this.terminal.onConnection = (open) => (this.connection.val = open ? `live · every ${LIVE_PERIOD_MS} ms` : "live data reconnecting…");
@@ -117,6 +131,7 @@ export class DashboardModel {
       this.message.val = { kind: "offline", text: `Drive not reachable: ${errorText(error)}`, bus: projectBus ?? null };
     }
     this.answered.val = true;
+    void this.refreshControl();
     const { statusword, modeDisplay, measurements, inputs, outputs } = this.signals;
     const watched = [statusword, modeDisplay, ...measurements, inputs, outputs].filter((entry): entry is Entry => entry !== null);
     this.terminal.watch(watched.slice(0, MAX_WATCHED).map((entry) => ({ bus: serverBus(this.bus), node: this.node, object: this.key(entry) })), LIVE_PERIOD_MS);
@@ -135,6 +150,37 @@ export class DashboardModel {
     } finally {
       this.busy.val = false;
     }
+  }
+
+  /** The caller may take an axis over from its controller (Expert and above). */
+  mayTakeOver(): boolean {
+    const level = this.context.page.app.live.user()?.level;
+    return level === "expert" || level === "administrator";
+  }
+
+  arm(): Promise<boolean> {
+    return this.guard("Arm", async () => void (this.control.val = await controlApi.arm(this.bus, this.node)));
+  }
+
+  release(): Promise<boolean> {
+    return this.guard("Release", async () => {
+      this.control.val = await controlApi.release(this.bus, this.node);
+      this.askedBy.val = null;
+    });
+  }
+
+  request(): Promise<boolean> {
+    return this.guard("Ask for the axis", async () => {
+      this.control.val = await controlApi.request(this.bus, this.node);
+      toast(`${this.control.rawVal?.holder?.user ?? "The controller"} was asked to release the axis`, "info");
+    });
+  }
+
+  async takeOver(): Promise<boolean> {
+    const holder = this.control.rawVal?.holder;
+    const text = `${holder?.user ?? "Another client"} holds this axis. Taking it over makes this page its controller at once (logged); the axis keeps its state.`;
+    if (!(await confirmAction("Take over the axis", text, "Take over", true))) return false;
+    return this.guard("Take over", async () => void (this.control.val = await controlApi.takeOver(this.bus, this.node)));
   }
 
   runCommand(command: Command): Promise<boolean> {
@@ -189,6 +235,14 @@ export class DashboardModel {
 
   refuse(label: string, reason: string): void {
     this.message.val = { kind: "error", text: `${label}: ${reason}`, testid: "dashboard-error" };
+  }
+
+  private async refreshControl(): Promise<void> {
+    try {
+      this.control.val = await controlApi.get(this.bus, this.node);
+    } catch {
+      this.control.val = null; // the bus is not open: the dashboard says so already
+    }
   }
 
   private cellOf(key: string): State<LiveCell> {

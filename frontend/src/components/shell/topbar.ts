@@ -2,6 +2,7 @@
 
 import type { App } from "../../app";
 import type { LiveHub } from "../../client/live";
+import { LOCAL_USER, session } from "../../client/session";
 import { h, type Child, type State } from "../../lib/dom";
 import { showHelp } from "../help";
 import { toggleTheme } from "../theme";
@@ -33,11 +34,19 @@ export function busStatus(live: LiveHub): HTMLElement {
   });
 }
 
+/** Who is logged in and at which level (docs/security.md), with a way out unless it is the password-less user. */
 export function userStatus(live: LiveHub): HTMLElement {
   return h("span", { class: "pill", "data-testid": "user-status", title: "User and level" }, () => {
     const user = live.userState.val;
-    return user ? `${user.name} · ${user.level}` : "local operator";
+    if (!user) return "not logged in";
+    const logOut = h("button", { class: "small", "data-testid": "log-out", onclick: () => void leave() }, "Log out");
+    return [`${user.name} · ${user.level}`, user.name === LOCAL_USER ? null : logOut];
   });
+}
+
+async function leave(): Promise<void> {
+  await session.logOut();
+  window.location.assign("/login");
 }
 
 export function serverStatus(server: State<ServerState>): HTMLElement {

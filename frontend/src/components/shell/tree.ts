@@ -14,6 +14,7 @@ const TOOLS: [Route, string][] = [
   [{ page: "terminal" }, "Dialog terminal"],
   [{ page: "dictionaries" }, "Object dictionaries"],
   [{ page: "motors" }, "Motor catalog"],
+  [{ page: "audit" }, "Audit log"],
 ];
 
 export function projectTree(app: App): HTMLElement {

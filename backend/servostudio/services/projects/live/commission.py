@@ -17,6 +17,7 @@ at the next file; a cancelled upload changes nothing in the project.
 
 from __future__ import annotations
 
+import contextvars
 import logging
 import shutil
 import tempfile
@@ -256,7 +257,8 @@ def _parallel(reports: list[AxisReport], work: Callable[[AxisReport], None]) -> 
     if not reports:
         return
     with ThreadPoolExecutor(max_workers=len(reports), thread_name_prefix="commission") as pool:
-        futures = [(report, pool.submit(work, report)) for report in reports]
+        # each axis's thread acts for the caller (motion guard, audit log): a copy of its context apiece
+        futures = [(report, pool.submit(contextvars.copy_context().run, work, report)) for report in reports]
         for report, future in futures:
             try:
                 future.result()

@@ -1,0 +1,251 @@
+"""The oscilloscope: live captures of a node's recorder, and captures saved in a project under their axis.
+
+A capture runs as a job (``POST …/scope/captures`` → 202 with the job; its ``progress`` events on /api/ws/events
+name the recorder's stage, the upload's bytes and each capture made); a definition the drive cannot capture is
+refused with 422 and the reason before anything is armed. ``…/scope/stop`` ends the job and the recorder (an
+Operator's way out; ``/api/jobs/{id}/cancel`` does the same for Maintenance and above).
+"""
+
+from __future__ import annotations
+
+from urllib.parse import quote
+
+from fastapi import APIRouter, Response, status
+
+from servostudio.api.deps import Jobs, NodeDrive, OpenBus, Projects, ScopeCaptures
+from servostudio.api.errors import error_responses
+from servostudio.api.routes.comm_models import JobModel
+from servostudio.api.routes.drives import DRIVE_ERRORS
+from servostudio.api.routes.scope_models import (
+    CaptureModel,
+    CaptureRequest,
+    ChannelModel,
+    PlanModel,
+    RecorderStatus,
+    SavedCaptureModel,
+    SaveRequest,
+    ScopeInfo,
+    capture_model,
+    saved_model,
+)
+from servostudio.api.security import Requires
+from servostudio.errors import ErrorKind
+from servostudio.services.scope import Capture, CaptureStore, ChannelInfo, capture_csv, capture_html, check
+from servostudio.services.scope.service import UnknownCapture
+from servostudio.services.users import Level
+
+LIVE = "/buses/{bus}/nodes/{node}/scope"
+SAVED = "/projects/{project}/axes/{axis}/captures"
+SAVED_ERRORS = (ErrorKind.NOT_FOUND, ErrorKind.CONFLICT)
+router = APIRouter(tags=["scope"])
+
+
+# ---- live -------------------------------------------------------------------------------------------------------
+
+
+@router.get(
+    LIVE,
+    response_model=ScopeInfo,
+    summary="The node's recorder: channels, buffer, base period, status, and the presets it can run",
+    responses=error_responses(*DRIVE_ERRORS),
+    dependencies=[Requires(Level.OPERATOR)],
+)
+def get_scope(drive: NodeDrive, scope: ScopeCaptures) -> dict:
+    return scope.describe(drive)
+
+
+@router.post(
+    f"{LIVE}/check",
+    response_model=PlanModel,
+    summary="Check a capture definition against the drive without arming anything (422 says why not)",
+    responses=error_responses(*DRIVE_ERRORS),
+    dependencies=[Requires(Level.OPERATOR)],
+)
+def check_capture(request: CaptureRequest, drive: NodeDrive) -> PlanModel:
+    plan = check(drive, request.definition())
+    return PlanModel(
+        channels=[ChannelModel(**vars(ChannelInfo.of(channel.variable))) for channel in plan.channels],
+        period_ns=plan.period_ns,
+        multiplier=plan.multiplier,
+        samples=plan.depth,
+        pre_trigger=plan.pre_trigger,
+        record_size=plan.record_size,
+        bytes=plan.total_bytes,
+    )
+
+
+@router.post(
+    f"{LIVE}/captures",
+    response_model=JobModel,
+    status_code=status.HTTP_202_ACCEPTED,
+    summary="Arm the recorder and capture as a job (single: one recording; normal, auto: until stopped)",
+    responses=error_responses(*DRIVE_ERRORS),
+    dependencies=[Requires(Level.OPERATOR)],
+)
+def start_capture(
+    request: CaptureRequest, connection: OpenBus, drive: NodeDrive, jobs: Jobs, scope: ScopeCaptures
+) -> dict:
+    return scope.start(jobs, connection, drive, request.definition()).as_dict()
+
+
+@router.get(
+    f"{LIVE}/status",
+    response_model=RecorderStatus,
+    summary="The recorder's status and the node's running capture job",
+    responses=error_responses(*DRIVE_ERRORS),
+    dependencies=[Requires(Level.OPERATOR)],
+)
+def get_status(bus: str, drive: NodeDrive, scope: ScopeCaptures) -> dict:
+    return scope.status(bus, drive)
+
+
+@router.post(
+    f"{LIVE}/force",
+    response_model=RecorderStatus,
+    summary="Force the trigger: the next sample is the trigger sample (while filling or waiting)",
+    responses=error_responses(*DRIVE_ERRORS),
+    dependencies=[Requires(Level.OPERATOR)],
+)
+def force_trigger(bus: str, drive: NodeDrive, scope: ScopeCaptures) -> dict:
+    scope.force(drive)
+    return scope.status(bus, drive)
+
+
+@router.post(
+    f"{LIVE}/stop",
+    response_model=RecorderStatus,
+    summary="Stop the node's capture job and the recorder (the last complete recording stays readable)",
+    responses=error_responses(*DRIVE_ERRORS),
+    dependencies=[Requires(Level.OPERATOR)],
+)
+def stop_capture(bus: str, drive: NodeDrive, scope: ScopeCaptures) -> dict:
+    scope.stop(bus, drive)
+    return scope.status(bus, drive)
+
+
+@router.get(
+    LIVE + "/captures/{capture_id}",
+    response_model=CaptureModel,
+    summary="A capture the server keeps (its id comes in the job's result and progress events)",
+    responses=error_responses(ErrorKind.NOT_FOUND),
+    dependencies=[Requires(Level.OPERATOR)],
+)
+def get_capture(bus: str, node: int, capture_id: str, scope: ScopeCaptures) -> CaptureModel:
+    return capture_model(_live(scope, bus, node, capture_id), capture_id)
+
+
+@router.get(
+    LIVE + "/captures/{capture_id}/csv",
+    response_class=Response,
+    summary="A capture as CSV (docs/scope.md, capture file format)",
+    responses={**error_responses(ErrorKind.NOT_FOUND), 200: {"content": {"text/csv": {}}}},
+    dependencies=[Requires(Level.OPERATOR)],
+)
+def get_capture_csv(bus: str, node: int, capture_id: str, scope: ScopeCaptures) -> Response:
+    made = _live(scope, bus, node, capture_id)
+    return _download(capture_csv(made), "text/csv", f"{_default_name(made)}.csv")
+
+
+@router.get(
+    LIVE + "/captures/{capture_id}/html",
+    response_class=Response,
+    summary="A capture as a standalone interactive HTML file (opens offline)",
+    responses={**error_responses(ErrorKind.NOT_FOUND), 200: {"content": {"text/html": {}}}},
+    dependencies=[Requires(Level.OPERATOR)],
+)
+def get_capture_html(bus: str, node: int, capture_id: str, scope: ScopeCaptures) -> Response:
+    made = _live(scope, bus, node, capture_id)
+    return _download(capture_html(made), "text/html", f"{_default_name(made)}.html")
+
+
+def _live(scope: ScopeCaptures, bus: str, node: int, capture_id: str) -> Capture:
+    """The capture of that id, if it came from the node the path names."""
+    made = scope.get(capture_id)
+    if (made.drive.bus, made.drive.node) != (bus, node):
+        raise UnknownCapture(f"no capture {capture_id!r} of bus {bus!r} node {node}")
+    return made
+
+
+# ---- saved in a project -----------------------------------------------------------------------------------------
+
+
+@router.get(
+    SAVED,
+    response_model=list[SavedCaptureModel],
+    summary="The captures saved under the axis (a damaged one names its file and line in `error`)",
+    responses=error_responses(*SAVED_ERRORS),
+    dependencies=[Requires(Level.OPERATOR)],
+)
+def list_saved(project: str, axis: str, projects: Projects) -> list[SavedCaptureModel]:
+    return [saved_model(saved) for saved in CaptureStore(projects.store).list(project, axis)]
+
+
+@router.post(
+    SAVED,
+    response_model=CaptureModel,
+    status_code=status.HTTP_201_CREATED,
+    summary="Save a live capture under the axis as CSV + JSON sidecar",
+    responses=error_responses(*SAVED_ERRORS),
+    dependencies=[Requires(Level.OPERATOR)],
+)
+def save_capture(project: str, axis: str, body: SaveRequest, projects: Projects, scope: ScopeCaptures) -> CaptureModel:
+    return capture_model(CaptureStore(projects.store).save(project, axis, scope.get(body.capture), body.name))
+
+
+@router.get(
+    SAVED + "/{name}",
+    response_model=CaptureModel,
+    summary="Re-open a saved capture (422 names the file and line of a damaged one)",
+    responses=error_responses(*SAVED_ERRORS),
+    dependencies=[Requires(Level.OPERATOR)],
+)
+def open_saved(project: str, axis: str, name: str, projects: Projects) -> CaptureModel:
+    return capture_model(CaptureStore(projects.store).open(project, axis, name))
+
+
+@router.get(
+    SAVED + "/{name}/csv",
+    response_class=Response,
+    summary="A saved capture's CSV",
+    responses={**error_responses(*SAVED_ERRORS), 200: {"content": {"text/csv": {}}}},
+    dependencies=[Requires(Level.OPERATOR)],
+)
+def saved_csv(project: str, axis: str, name: str, projects: Projects) -> Response:
+    made = CaptureStore(projects.store).open(project, axis, name)
+    return _download(capture_csv(made), "text/csv", f"{name}.csv")
+
+
+@router.get(
+    SAVED + "/{name}/html",
+    response_class=Response,
+    summary="A saved capture as a standalone interactive HTML file",
+    responses={**error_responses(*SAVED_ERRORS), 200: {"content": {"text/html": {}}}},
+    dependencies=[Requires(Level.OPERATOR)],
+)
+def saved_html(project: str, axis: str, name: str, projects: Projects) -> Response:
+    made = CaptureStore(projects.store).open(project, axis, name)
+    return _download(capture_html(made), "text/html", f"{name}.html")
+
+
+@router.delete(
+    SAVED + "/{name}",
+    status_code=status.HTTP_204_NO_CONTENT,
+    response_class=Response,
+    summary="Delete a saved capture (changing the project's records needs Expert, like the project itself)",
+    responses=error_responses(*SAVED_ERRORS),
+    dependencies=[Requires(Level.EXPERT)],
+)
+def delete_saved(project: str, axis: str, name: str, projects: Projects) -> Response:
+    CaptureStore(projects.store).delete(project, axis, name)
+    return Response(status_code=status.HTTP_204_NO_CONTENT)
+
+
+def _default_name(made: Capture) -> str:
+    return made.name or f"capture node{made.drive.node} {made.captured_at.replace(':', '-')}"
+
+
+def _download(body: str, media_type: str, file_name: str) -> Response:
+    """A file download; the name also in RFC 5987 form, so a non-ASCII name arrives whole."""
+    fallback = file_name.encode("ascii", "replace").decode().replace('"', "'")
+    disposition = f"attachment; filename=\"{fallback}\"; filename*=UTF-8''{quote(file_name)}"
+    return Response(body, media_type=media_type, headers={"Content-Disposition": disposition})

@@ -1,0 +1,177 @@
+"""The REST contract of the oscilloscope: a capture definition as a client sends it, and a capture as it comes back
+(physical values per channel; time of sample i = (i − trigger_index) × period_ns, 0 = the trigger)."""
+
+from __future__ import annotations
+
+import math
+from typing import Annotated, Literal
+
+from pydantic import BaseModel, ConfigDict, Field
+
+from servostudio.services.scope import Capture, CaptureDefinition, SavedCapture, Trigger
+
+#: an object as a client names it: address (0x606C,0), name or profile name
+ObjectName = Annotated[str, Field(min_length=1, max_length=80)]
+
+
+class TriggerModel(BaseModel):
+    model_config = ConfigDict(extra="forbid")
+    source: str | None = Field(
+        None, min_length=1, max_length=80, description="object or channel that triggers; none: immediate"
+    )
+    edge: Literal["rising", "falling", "either"] = "rising"
+    level: float = Field(0.0, ge=-1e12, le=1e12, description="in the source's physical unit")
+
+
+class CaptureRequest(BaseModel):
+    """A capture definition; the drive's dictionary and recorder check it before anything is armed."""
+
+    model_config = ConfigDict(
+        extra="forbid",
+        json_schema_extra={
+            "examples": [
+                {
+                    "channels": ["0x60FF,0", "0x606C,0", "0x6078,0", "0x6041,0"],
+                    "period_us": 250,
+                    "samples": 2048,
+                    "trigger": {"source": "0x606C,0", "edge": "rising", "level": 20480},
+                    "pre_trigger_pct": 20,
+                    "mode": "single",
+                }
+            ]
+        },
+    )
+    channels: list[ObjectName] = Field(min_length=1, max_length=16, description="objects by address or name")
+    period_us: float = Field(250.0, gt=0, le=1e9, description="a multiple of the drive's base period")
+    samples: int | None = Field(None, ge=1, le=1_000_000, description="depth; else from duration_s, else the buffer")
+    duration_s: float | None = Field(None, gt=0, le=1e6)
+    trigger: TriggerModel = Field(default_factory=lambda: TriggerModel.model_validate({}))
+    pre_trigger_pct: float = Field(0.0, ge=0, le=100)
+    mode: Literal["single", "normal", "auto"] = "single"
+    auto_timeout_ms: int = Field(100, ge=0, le=10**9)
+    timeout_s: float | None = Field(None, gt=0, le=86400, description="give up when no recording completes by then")
+
+    def definition(self) -> CaptureDefinition:
+        fields = self.model_dump()
+        fields["channels"] = tuple(self.channels)
+        fields["trigger"] = Trigger(**self.trigger.model_dump())
+        return CaptureDefinition(**fields)
+
+    @classmethod
+    def of(cls, definition: CaptureDefinition) -> CaptureRequest:
+        return cls.model_validate(definition.as_dict())
+
+
+class PresetModel(BaseModel):
+    key: str
+    title: str
+    description: str
+    definition: CaptureRequest
+
+
+class ScopeInfo(BaseModel):
+    """The drive's recorder: its limits, its status and the presets this drive can run."""
+
+    channels: int
+    capacity: int = Field(description="bytes of one recording")
+    base_period_ns: int
+    status: str
+    presets: list[PresetModel]
+
+
+class RecorderStatus(BaseModel):
+    status: str = Field(description="idle, filling, waiting, recording or done")
+    counter: int = Field(description="recordings completed (wraps at 65536)")
+    job: str | None = Field(None, description="the node's capture job while it runs")
+
+
+class ChannelModel(BaseModel):
+    key: str = Field(examples=["0x606C,0"])
+    name: str
+    unit: str
+    data_type: str
+    scale: float
+    offset: float
+
+
+class PlanModel(BaseModel):
+    """A definition the drive accepts, as the recorder will run it."""
+
+    channels: list[ChannelModel]
+    period_ns: int
+    multiplier: int
+    samples: int
+    pre_trigger: int
+    record_size: int
+    bytes: int
+
+
+class DriveIdentityModel(BaseModel):
+    bus: str
+    node: int
+    device: str
+    product_name: str
+    vendor_id: int | None
+    product_code: int | None
+    revision: int | None
+    serial_number: int | None
+    software_version: str | None
+
+
+class CaptureModel(BaseModel):
+    id: str | None = Field(None, description="the server's id of a live capture (it keeps the latest ones)")
+    name: str | None = Field(None, description="the name of a capture saved in a project")
+    definition: CaptureRequest
+    channels: list[ChannelModel]
+    period_ns: int
+    samples: int
+    trigger_index: int = Field(description="the trigger sample: time 0")
+    trigger: str
+    values: list[list[float | None]] = Field(description="physical values, one list per channel")
+    drive: DriveIdentityModel
+    captured_at: str
+    source: str
+
+
+class SaveRequest(BaseModel):
+    model_config = ConfigDict(extra="forbid")
+    capture: str = Field(min_length=1, max_length=64, description="id of a live capture")
+    name: str | None = Field(None, min_length=1, max_length=64, description="default: the time of capture")
+
+
+class SavedCaptureModel(BaseModel):
+    name: str
+    captured_at: str
+    channels: list[str]
+    samples: int
+    period_ns: int
+    trigger: str
+    source: str
+    error: str | None = Field(None, description="why the capture cannot be read (file and line)")
+
+
+def capture_model(capture: Capture, capture_id: str | None = None) -> CaptureModel:
+    return CaptureModel(
+        id=capture_id,
+        name=capture.name or None,
+        definition=CaptureRequest.of(capture.definition),
+        channels=[ChannelModel(**vars(channel)) for channel in capture.channels],
+        period_ns=capture.period_ns,
+        samples=capture.samples,
+        trigger_index=capture.trigger_index,
+        trigger=capture.trigger,
+        values=[[_finite(value) for value in capture.physical(n)] for n in range(len(capture.channels))],
+        drive=DriveIdentityModel(**vars(capture.drive)),
+        captured_at=capture.captured_at,
+        source=capture.source,
+    )
+
+
+def _finite(value: float) -> float | None:
+    """JSON has no NaN or infinity (a REAL32 channel may hold them): those samples are null."""
+    return value if math.isfinite(value) else None
+
+
+def saved_model(saved: SavedCapture) -> SavedCaptureModel:
+    fields = vars(saved) | {"channels": list(saved.channels)}
+    return SavedCaptureModel(**fields)

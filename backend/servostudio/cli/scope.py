@@ -1,0 +1,130 @@
+"""``servostudio scope``: one oscilloscope capture of a drive's recorder into a CSV file (and an HTML file).
+
+Pinned for scripts (issue #12)::
+
+    servostudio scope --bus SPEC --node N --ch 0x606C,0 [--ch OBJ …] [--period-us 250] [--samples 2048]
+        [--trigger OBJ:rising|falling|either:LEVEL | --immediate] [--pretrigger PCT] [--timeout S]
+        --out FILE.csv [--html FILE.html]
+
+The files are the capture service's (docs/scope.md): written only once the recording is read completely, each
+atomically, so a failed capture leaves none. Stdout gets a JSON summary; the exit code is the error's kind (3 refused
+before anything was armed, 4 unknown node or object, 5 the bus or the drive failed or no recording in time).
+"""
+
+from __future__ import annotations
+
+import argparse
+import signal
+import sys
+import threading
+from collections.abc import Callable
+from pathlib import Path
+
+from servostudio.cli.output import emit
+from servostudio.drive.link import LinkDownError
+from servostudio.errors import InvalidInput
+from servostudio.formats.textfile import write_bytes_atomic
+from servostudio.services.bus import ConnectionManager
+from servostudio.services.cancel import Cancellation, Cancelled
+from servostudio.services.scan import identified
+from servostudio.services.scope import (
+    Capture,
+    CaptureDefinition,
+    Trigger,
+    capture,
+    capture_csv,
+    capture_html,
+    identity_of,
+    parse_trigger,
+)
+from servostudio.services.scope.definition import DEFAULT_PERIOD_US, DEFAULT_SAMPLES
+
+CONNECT_WAIT = 3.0
+DEFAULT_TIMEOUT_S = 10.0
+EXIT_INTERRUPTED = 130  # the shell's code for a command ended by Ctrl-C
+
+
+class RemoteScopeUnavailable(InvalidInput):
+    """``--server`` does not reach the recorder yet: the CLI opens the bus itself."""
+
+
+def register(commands: argparse._SubParsersAction) -> None:
+    parser = commands.add_parser("scope", help="capture up to 4 signals with the drive's recorder into a CSV file")
+    parser.add_argument("--bus", required=True, metavar="SPEC", help="e.g. socketcand:127.0.0.1:29536, sim")
+    parser.add_argument("--node", type=int, required=True, help="node ID 1..127")
+    parser.add_argument(
+        "--ch", action="append", required=True, metavar="OBJ", help="channel: 0x606C,0, a name or statusword"
+    )
+    parser.add_argument("--period-us", type=float, default=DEFAULT_PERIOD_US, help="sample period (default 250 µs)")
+    parser.add_argument("--samples", type=int, default=DEFAULT_SAMPLES, help="samples per channel (default 2048)")
+    trigger = parser.add_mutually_exclusive_group()
+    trigger.add_argument("--trigger", metavar="OBJ:EDGE:LEVEL", help="e.g. 0x606C,0:rising:20480 (level in its unit)")
+    trigger.add_argument("--immediate", action="store_true", help="record from the arm (the default)")
+    parser.add_argument("--pretrigger", type=float, default=0.0, metavar="PCT", help="share before the trigger, %%")
+    parser.add_argument("--timeout", type=float, default=DEFAULT_TIMEOUT_S, metavar="S", help="wait for the recording")
+    parser.add_argument("--out", type=Path, required=True, metavar="FILE.csv")
+    parser.add_argument("--html", type=Path, metavar="FILE.html", help="also a standalone interactive HTML file")
+    parser.set_defaults(handler=_scope)
+
+
+def definition_of(args: argparse.Namespace) -> CaptureDefinition:
+    return CaptureDefinition(
+        channels=tuple(args.ch),
+        period_us=args.period_us,
+        samples=args.samples,
+        trigger=parse_trigger(args.trigger) if args.trigger else Trigger(),
+        pre_trigger_pct=args.pretrigger,
+        timeout_s=args.timeout,
+    )
+
+
+def _scope(args: argparse.Namespace) -> int:
+    if getattr(args, "server", None):
+        raise RemoteScopeUnavailable("scope does not work through --server yet; name the bus with --bus")
+    definition = definition_of(args)  # refused before the bus is opened
+    manager = ConnectionManager()
+    try:
+        connection = manager.open(args.bus, wait=CONNECT_WAIT)
+        if not connection.link.connected:
+            raise LinkDownError(f"bus {args.bus}: not connected ({connection.link.last_error or 'no answer'})")
+        identified(connection, args.node)
+        drive = connection.drive(args.node)
+        made = _interruptible(lambda cancellation: capture(drive, identity_of(connection, drive), definition,
+                                                           cancellation=cancellation))  # fmt: skip
+    except Cancelled as stopped:
+        print(f"error: {stopped}; the recorder was stopped", file=sys.stderr)
+        return EXIT_INTERRUPTED
+    finally:
+        manager.close_all()
+    return emit(_write(made, args.out, args.html))
+
+
+def _interruptible(work: Callable[[Cancellation], Capture]) -> Capture:
+    """Run ``work(cancellation)``; Ctrl-C or SIGTERM cancels it (the service then stops the recorder). Signals reach
+    only the main thread: a command run from another thread (an embedding program) just runs."""
+    cancellation = Cancellation()
+    signals = (signal.SIGINT, signal.SIGTERM) if threading.current_thread() is threading.main_thread() else ()
+    handlers = {sig: signal.signal(sig, lambda *_: cancellation.cancel()) for sig in signals}
+    try:
+        return work(cancellation)
+    finally:
+        for sig, handler in handlers.items():
+            signal.signal(sig, handler)
+
+
+def _write(made: Capture, out: Path, html: Path | None) -> dict[str, object]:
+    """The files, each atomically, and what the JSON summary says of them."""
+    write_bytes_atomic(out, capture_csv(made).encode("utf-8"))
+    if html is not None:
+        write_bytes_atomic(html, capture_html(made).encode("utf-8"))
+    return {
+        "out": str(out),
+        "html": str(html) if html is not None else None,
+        "node": made.drive.node,
+        "channels": [channel.key for channel in made.channels],
+        "samples": made.samples,
+        "period_us": made.period_ns / 1000,
+        "trigger": made.trigger,
+        "trigger_index": made.trigger_index,
+        "captured": made.captured_at,
+    }

@@ -1,0 +1,135 @@
+"""What a batch of writes will make an axis do, judged on the values the drive will receive.
+
+The guard must not be fooled by how a caller spells a value (``"15.0"``, ``"1.5e1"``, ``0x8F``) nor by where the
+write comes from (a drive file, a restore, the terminal): it judges :class:`~servostudio.drive.access.PlannedWrite`
+s — raw values after the dictionary's conversion — and plays the control words through the CiA 402 state machine
+(``drive.cia402.transition``) from the state the drive is in, in the order the drive will apply them.  Which objects
+move the axis is the device profile's to say (``motion_objects``, ``moving_procedures``), by semantic name.
+"""
+
+from __future__ import annotations
+
+import enum
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, replace
+
+from servostudio.drive.access import PlannedWrite
+from servostudio.drive.cia402 import State, transition
+from servostudio.drive.profiles import DeviceProfile, signature_value
+
+
+class Motion(enum.IntEnum):
+    """What writes make the axis do, from the harmless to what needs the axis's armed controller."""
+
+    NONE = 0  # no motion object among them
+    STOPS = 1  # the axis leaves Operation enabled (disable, quick stop): anyone may stop an axis
+    PREPARES = 2  # motion objects while the axis stays disabled: the controller's, when the axis has one
+    MOVES = 3  # enables, changes what an enabled axis does, or starts a procedure that turns the motor
+
+
+@dataclass(frozen=True)
+class Verdict:
+    """The guard's judgment of a batch: the worst of its writes, why, and whether the axis starts or stops."""
+
+    motion: Motion = Motion.NONE
+    reason: str = ""
+    enables: bool = False
+    stops: bool = False
+
+    def worse(self, other: Verdict) -> Verdict:
+        """The batch's verdict so far and one more write: the graver motion and its reason decide."""
+        graver = other if other.motion > self.motion else self
+        return replace(graver, enables=self.enables or other.enables, stops=self.stops or other.stops)
+
+
+NO_MOTION = Verdict()
+
+
+class _Role(enum.Enum):
+    CONTROLWORD = "controlword"
+    MOTION_OBJECT = "motion object"
+    PROCEDURE = "procedure"
+
+
+@dataclass(frozen=True)
+class MotionObjects:
+    """A device profile's motion objects by address: what each one is, and for procedures the starting value."""
+
+    roles: Mapping[tuple[int, int], _Role]
+    starts: Mapping[tuple[int, int], int]
+
+    @classmethod
+    def of(cls, profile: DeviceProfile) -> MotionObjects:
+        roles = {profile.address(name): _Role.MOTION_OBJECT for name in profile.motion_objects if profile.has(name)}
+        starts = {profile.address(name): signature_value(text) for name, text in profile.moving_procedures.items()}
+        roles.update(dict.fromkeys(starts, _Role.PROCEDURE))
+        if profile.has("controlword"):
+            roles[profile.address("controlword")] = _Role.CONTROLWORD
+        return cls(roles, starts)
+
+    def touched_by(self, writes: Sequence[PlannedWrite]) -> bool:
+        """Whether any write concerns motion at all (else the drive's state need not be read)."""
+        return any(write.key in self.roles for write in writes)
+
+
+def judge(objects: MotionObjects, state: State | None, writes: Sequence[PlannedWrite]) -> Verdict:
+    """What ``writes``, applied in order, make an axis in ``state`` do.  None is a state the status word does not
+    tell: every motion write is then judged as moving, and the state stays unknown."""
+    verdict = NO_MOTION
+    for write in writes:
+        step, state = _judge_one(objects, state, write)
+        verdict = verdict.worse(step)
+    return verdict
+
+
+def _judge_one(objects: MotionObjects, state: State | None, write: PlannedWrite) -> tuple[Verdict, State | None]:
+    role = objects.roles.get(write.key)
+    if role is _Role.CONTROLWORD:
+        return _controlword(state, write.raw)
+    if role is _Role.PROCEDURE:
+        return _procedure(objects, write), state
+    if role is _Role.MOTION_OBJECT:
+        return _motion_object(state, write), state
+    return NO_MOTION, state
+
+
+def _controlword(state: State | None, raw: object) -> tuple[Verdict, State | None]:
+    """A control word: the transition it makes the drive take from ``state``."""
+    if not isinstance(raw, int):
+        return Verdict(Motion.MOVES, f"control word {raw!r} is no integer the guard can judge"), None
+    if state is None:
+        return Verdict(Motion.MOVES, f"control word 0x{raw:04X} to an axis whose state is unknown", enables=True), None
+    after = transition(state, raw)
+    shown = f"control word 0x{raw:04X} takes the axis from {state.value} to {after.value}"
+    if after is State.OPERATION_ENABLED:
+        return Verdict(Motion.MOVES, shown, enables=state is not State.OPERATION_ENABLED), after
+    if _POWER.get(after, 0) < _POWER.get(state, 0):
+        return Verdict(Motion.STOPS, shown, stops=state is State.OPERATION_ENABLED), after
+    return Verdict(Motion.PREPARES, shown), after
+
+
+#: how far up the ladder a state is: a transition to a lower one powers the axis down, a stop anyone may make
+_POWER = {
+    State.SWITCH_ON_DISABLED: 0,
+    State.READY_TO_SWITCH_ON: 1,
+    State.SWITCHED_ON: 2,
+    State.OPERATION_ENABLED: 3,
+    State.QUICK_STOP_ACTIVE: 2,  # stopped, below Operation enabled
+}
+
+
+def _procedure(objects: MotionObjects, write: PlannedWrite) -> Verdict:
+    """A procedure trigger: its start signature turns the motor even with the power stage off."""
+    if write.raw != objects.starts[write.key]:
+        return NO_MOTION
+    return Verdict(
+        Motion.MOVES, f"0x{write.index:04X},{write.sub} = {write.raw:#x} starts a procedure that turns the motor"
+    )
+
+
+def _motion_object(state: State | None, write: PlannedWrite) -> Verdict:
+    """A target, mode or profile value: it moves an enabled axis, and prepares the next motion of a disabled one."""
+    label = write.variable.label if write.variable is not None else f"0x{write.index:04X},{write.sub}"
+    if state in (State.OPERATION_ENABLED, None):
+        return Verdict(Motion.MOVES, f"{label} = {write.raw!r} changes what the enabled axis does")
+    return Verdict(Motion.PREPARES, f"{label} = {write.raw!r} sets up the axis's next motion")

@@ -1,0 +1,53 @@
+"""A link cut during the upload of a recording: a clear error, nothing kept, the recorder left clean, and the next
+capture works once the link is back (the simulated drives over socketcand, whose endpoint the test cuts)."""
+
+from __future__ import annotations
+
+import time
+
+import pytest
+from tests.support.embedded_sim import SDO_TIMEOUT
+
+from servostudio.services.bus import ConnectionManager
+from servostudio.services.scope import CaptureDefinition, UploadFailed, capture, identity_of
+
+FULL = CaptureDefinition(("0x6064,0", "0x606C,0", "0x6062,0", "0x60F4,0"), samples=2048)  # 32 KB
+
+
+@pytest.fixture
+def connection(socketcand):
+    manager = ConnectionManager()
+    opened = manager.open(socketcand.spec, wait=5.0)
+    opened.engine.timeout = SDO_TIMEOUT
+    yield opened
+    manager.close_all()
+
+
+def wait_connected(connection, timeout: float = 15.0) -> None:
+    deadline = time.monotonic() + timeout
+    while not connection.link.connected:
+        assert time.monotonic() < deadline, "the link did not come back"
+        time.sleep(0.05)
+
+
+def test_a_cut_during_the_upload_fails_cleanly_and_the_next_capture_works(connection, socketcand, sim_network, slow):
+    drive = connection.drive(1)
+    cut: list[dict] = []
+
+    def cut_mid_upload(event: dict) -> None:
+        if event["stage"] == "uploading" and event["done"] > 0 and not cut:
+            cut.append(event)
+            socketcand.cut()
+
+    with slow(sim_network), pytest.raises(UploadFailed) as failed:
+        capture(drive, identity_of(connection, drive), FULL, cut_mid_upload)
+    assert cut and cut[0]["done"] < cut[0]["total"] == 32768
+    assert "the upload of the recording failed" in str(failed.value) and "nothing was kept" in str(failed.value)
+    assert failed.value.kind.value == "communication"
+
+    socketcand.restore()
+    wait_connected(connection)
+    with sim_network.lock:
+        assert sim_network.node(1).store.get(0x5829, 0) == 4  # done: the recording is still there, nothing armed
+    again = capture(drive, identity_of(connection, drive), CaptureDefinition(("0x6041,0",), samples=64))
+    assert again.samples == 64 and again.columns[0][0] == drive.read("0x6041").raw
