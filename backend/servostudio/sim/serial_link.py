@@ -15,9 +15,7 @@ Two endpoints carry the byte stream: a raw TCP server (pyserial `socket://HOST:P
 
 from __future__ import annotations
 
-import contextlib
 import os
-import queue
 import select
 import socket
 import threading
@@ -26,37 +24,13 @@ import tty
 from servostudio.sim.frame import Frame
 from servostudio.sim.network import SimulatedNetwork
 from servostudio.sim.node import REDIRECTED_REQUEST_BASE, REDIRECTED_RESPONSE_BASE, SimulatedNode
-from servostudio.sim.tcp import TcpListener
+from servostudio.sim.tcp import QueuedWriter, StreamListener
 from servostudio.transport.rs232_framing import DRIVE_HEADER, HOST_HEADER, FrameDecoder, encode_frame
 
 FORWARDED = range(REDIRECTED_REQUEST_BASE + 1, REDIRECTED_REQUEST_BASE + 64)  # 0x641–0x67F
 RELAYED = range(REDIRECTED_RESPONSE_BASE + 1, REDIRECTED_RESPONSE_BASE + 64)  # 0x5C1–0x5FF
 SDO_RESPONSES = range(0x581, 0x600)
 QUIRK_OFFSET = 0x80  # response identifier -> request identifier
-OUTPUT_QUEUE_LIMIT = 100_000  # frames waiting for an endpoint nobody reads; beyond it they are dropped
-
-
-class _Writer:
-    """Drains bytes to one endpoint on its own thread, so the simulation never blocks on a slow reader."""
-
-    def __init__(self, write, name: str) -> None:
-        self._write = write
-        self._queue: queue.SimpleQueue[bytes | None] = queue.SimpleQueue()
-        threading.Thread(target=self._run, name=name, daemon=True).start()
-
-    def put(self, data: bytes) -> None:
-        if self._queue.qsize() < OUTPUT_QUEUE_LIMIT:
-            self._queue.put(data)
-
-    def close(self) -> None:
-        self._queue.put(None)
-
-    def _run(self) -> None:
-        while (data := self._queue.get()) is not None:
-            try:
-                self._write(data)
-            except OSError:
-                return
 
 
 class SerialGateway:
@@ -68,7 +42,7 @@ class SerialGateway:
         self.network = network
         self.node = node or network.first_node
         self.response_id_quirk = response_id_quirk
-        self._writers: list[_Writer] = []
+        self._writers: list[QueuedWriter] = []
         network.attach(self)
 
     def close(self) -> None:
@@ -76,10 +50,10 @@ class SerialGateway:
 
     # -- line side ------------------------------------------------------------------------------------------------
 
-    def add_writer(self, writer: _Writer) -> None:
+    def add_writer(self, writer: QueuedWriter) -> None:
         self._writers.append(writer)
 
-    def remove_writer(self, writer: _Writer) -> None:
+    def remove_writer(self, writer: QueuedWriter) -> None:
         if writer in self._writers:
             self._writers.remove(writer)
 
@@ -112,7 +86,7 @@ class SerialGateway:
             self._to_host(frame)
 
 
-class SerialTcpServer(TcpListener):
+class SerialTcpServer(StreamListener):
     """The line as a raw TCP byte stream (pyserial `socket://HOST:PORT`); every connection sees the drive's output."""
 
     name = "serial-tcp"
@@ -120,32 +94,17 @@ class SerialTcpServer(TcpListener):
     def __init__(self, gateway: SerialGateway, host: str = "127.0.0.1", port: int = 0) -> None:
         super().__init__(host, port)
         self.gateway = gateway
-        self._connections: list[socket.socket] = []
-
-    def _connected(self, connection: socket.socket) -> None:
-        connection.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
-        self._connections.append(connection)
-        threading.Thread(target=self._serve, args=(connection,), name="serial-tcp-rx", daemon=True).start()
-
-    def _close_connections(self) -> None:
-        for connection in list(self._connections):
-            _close_socket(connection)
 
     def _serve(self, connection: socket.socket) -> None:
-        writer = _Writer(connection.sendall, "serial-tcp-tx")
+        writer = QueuedWriter(connection.sendall, "serial-tcp-tx")
         self.gateway.add_writer(writer)
         decoder = FrameDecoder(HOST_HEADER)
         try:
             while chunk := connection.recv(4096):
                 self.gateway.host_frames(decoder.feed(chunk))
-        except OSError:
-            pass
         finally:
             self.gateway.remove_writer(writer)
             writer.close()
-            if connection in self._connections:
-                self._connections.remove(connection)
-            _close_socket(connection)
 
 
 class SerialPty:
@@ -157,7 +116,7 @@ class SerialPty:
         tty.setraw(self._slave)
         self.path = os.ttyname(self._slave)
         self._stop = threading.Event()
-        self._writer = _Writer(lambda data: os.write(self._master, data), "serial-pty-tx")
+        self._writer = QueuedWriter(lambda data: os.write(self._master, data), "serial-pty-tx")
         self._thread = threading.Thread(target=self._read_loop, name="serial-pty-rx", daemon=True)
 
     def start(self) -> SerialPty:
@@ -191,9 +150,3 @@ class SerialPty:
             except OSError:
                 return
             self.gateway.host_frames(decoder.feed(chunk))
-
-
-def _close_socket(connection: socket.socket) -> None:
-    with contextlib.suppress(OSError):
-        connection.shutdown(socket.SHUT_RDWR)
-    connection.close()

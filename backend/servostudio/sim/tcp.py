@@ -1,16 +1,23 @@
-"""A TCP listener on its own thread: the common part of the simulator's socketcand and serial-link endpoints."""
+"""The common parts of the simulator's byte-stream endpoints (socketcand, the RS-232 link, the PROFIBUS line): a TCP
+listener on its own thread, a listener whose connections each get a reader thread, and an output queue drained on
+its own thread, so a slow reader never blocks the simulation."""
 
 from __future__ import annotations
 
+import contextlib
 import logging
+import queue
 import socket
 import threading
+from collections.abc import Callable
 from typing import Self
 
 log = logging.getLogger(__name__)
 
 #: How often the accept loop looks at its stop flag.
 ACCEPT_POLL = 0.2
+#: Chunks queued for an endpoint nobody reads; beyond it they are dropped.
+OUTPUT_LIMIT = 100_000
 
 
 class TcpListener:
@@ -62,3 +69,62 @@ class TcpListener:
 
     def _close_connections(self) -> None:
         raise NotImplementedError
+
+
+class StreamListener(TcpListener):
+    """A listener whose every connection is served by `_serve` on a thread of its own, and closed after it."""
+
+    def __init__(self, host: str, port: int) -> None:
+        super().__init__(host, port)
+        self._connections: list[socket.socket] = []
+
+    def _connected(self, connection: socket.socket) -> None:
+        connection.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
+        self._connections.append(connection)
+        threading.Thread(target=self._serve_then_close, args=(connection,), name=f"{self.name}-rx", daemon=True).start()
+
+    def _close_connections(self) -> None:
+        for connection in list(self._connections):
+            close_socket(connection)
+
+    def _serve_then_close(self, connection: socket.socket) -> None:
+        try:
+            self._serve(connection)
+        except OSError:
+            pass
+        finally:
+            if connection in self._connections:
+                self._connections.remove(connection)
+            close_socket(connection)
+
+    def _serve(self, connection: socket.socket) -> None:
+        raise NotImplementedError
+
+
+class QueuedWriter:
+    """Drains bytes to one endpoint on its own thread, so the simulation never blocks on a slow reader."""
+
+    def __init__(self, write: Callable[[bytes], object], name: str) -> None:
+        self._write = write
+        self._queue: queue.SimpleQueue[bytes | None] = queue.SimpleQueue()
+        threading.Thread(target=self._run, name=name, daemon=True).start()
+
+    def put(self, data: bytes) -> None:
+        if self._queue.qsize() < OUTPUT_LIMIT:
+            self._queue.put(data)
+
+    def close(self) -> None:
+        self._queue.put(None)
+
+    def _run(self) -> None:
+        while (data := self._queue.get()) is not None:
+            try:
+                self._write(data)
+            except OSError:
+                return
+
+
+def close_socket(connection: socket.socket) -> None:
+    with contextlib.suppress(OSError):
+        connection.shutdown(socket.SHUT_RDWR)
+    connection.close()

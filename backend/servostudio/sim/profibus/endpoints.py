@@ -1,14 +1,12 @@
 """The simulated PROFIBUS line as a raw TCP byte stream (pyserial `socket://HOST:PORT`) or a pseudo-terminal in raw
 mode, like the XtrapulsPac RS-232 link (`servostudio.sim.serial_link`). A reader that sees no byte for `IDLE_TIME`
 tells its decoder the line is idle, which drops a telegram whose end never came (the sync time of a real line).
-Output goes through a queue drained on its own thread, so a slow reader never blocks the simulation.
+Output goes through `sim.tcp.QueuedWriter`, so a slow reader never blocks the simulation.
 """
 
 from __future__ import annotations
 
-import contextlib
 import os
-import queue
 import select
 import socket
 import threading
@@ -16,34 +14,11 @@ import tty
 from collections.abc import Callable
 
 from servostudio.sim.profibus.line import Port, ProfibusLine
-from servostudio.sim.tcp import TcpListener
+from servostudio.sim.tcp import QueuedWriter, StreamListener
 
 IDLE_TIME = 0.02
 """Seconds without a byte after which a partial telegram is dropped."""
 READ_SIZE = 4096
-OUTPUT_LIMIT = 100_000
-"""Chunks queued for a reader that does not read; beyond it they are dropped."""
-
-
-class QueuedWriter:
-    def __init__(self, write: Callable[[bytes], object], name: str) -> None:
-        self._write = write
-        self._queue: queue.SimpleQueue[bytes | None] = queue.SimpleQueue()
-        threading.Thread(target=self._run, name=name, daemon=True).start()
-
-    def put(self, data: bytes) -> None:
-        if self._queue.qsize() < OUTPUT_LIMIT:
-            self._queue.put(data)
-
-    def close(self) -> None:
-        self._queue.put(None)
-
-    def _run(self) -> None:
-        while (data := self._queue.get()) is not None:
-            try:
-                self._write(data)
-            except OSError:
-                return
 
 
 def _read_loop(port: Port, wait: Callable[[float], bool], read: Callable[[], bytes], stop: threading.Event) -> None:
@@ -59,7 +34,7 @@ def _read_loop(port: Port, wait: Callable[[float], bool], read: Callable[[], byt
         port.feed(data)
 
 
-class ProfibusTcpServer(TcpListener):
+class ProfibusTcpServer(StreamListener):
     """Every connection is a port of the line and sees every response on it."""
 
     name = "profibus-tcp"
@@ -67,16 +42,6 @@ class ProfibusTcpServer(TcpListener):
     def __init__(self, line: ProfibusLine, host: str = "127.0.0.1", port: int = 0) -> None:
         super().__init__(host, port)
         self.line = line
-        self._connections: list[socket.socket] = []
-
-    def _connected(self, connection: socket.socket) -> None:
-        connection.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
-        self._connections.append(connection)
-        threading.Thread(target=self._serve, args=(connection,), name="profibus-tcp-rx", daemon=True).start()
-
-    def _close_connections(self) -> None:
-        for connection in list(self._connections):
-            _close_socket(connection)
 
     def _serve(self, connection: socket.socket) -> None:
         writer = QueuedWriter(connection.sendall, "profibus-tcp-tx")
@@ -85,14 +50,9 @@ class ProfibusTcpServer(TcpListener):
             _read_loop(
                 port, lambda timeout: _readable(connection, timeout), lambda: connection.recv(READ_SIZE), self._stop
             )
-        except OSError:
-            pass
         finally:
             port.close()
             writer.close()
-            if connection in self._connections:
-                self._connections.remove(connection)
-            _close_socket(connection)
 
 
 class ProfibusPty:
@@ -133,9 +93,3 @@ class ProfibusPty:
 
 def _readable(source: socket.socket | int, timeout: float) -> bool:
     return bool(select.select([source], [], [], timeout)[0])
-
-
-def _close_socket(connection: socket.socket) -> None:
-    with contextlib.suppress(OSError):
-        connection.shutdown(socket.SHUT_RDWR)
-    connection.close()
