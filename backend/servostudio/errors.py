@@ -131,3 +131,8 @@ class RateLimited(ServoStudioError):
     """Too many failed logins in a row: this user or address must wait before the next try."""
 
     kind = ErrorKind.RATE_LIMITED
+
+    def __init__(self, message: str, retry_after: float) -> None:
+        super().__init__(message)
+        #: seconds until the next try may succeed (the HTTP answer's ``Retry-After``)
+        self.retry_after = retry_after

@@ -183,6 +183,7 @@ def test_login_is_rate_limited_per_user_and_per_address(tmp_path):
             )
         locked = httpx.post(login, json={"name": "dave", "password": PASSWORD})  # even the right password
         assert "try again in" in refused(locked, 429, "rate_limited", "TooManyLogins")
+        assert 14 * 60 < int(locked.headers["Retry-After"]) <= 15 * 60  # the window is 15 minutes
         for attempt in range(15):  # 5 + 15 = 20 failures from this address, each name tried once
             refused(
                 httpx.post(login, json={"name": f"nobody{attempt}", "password": "x"}),

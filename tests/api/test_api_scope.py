@@ -136,10 +136,25 @@ def test_saved_captures_of_an_axis(client):
     assert client.get(base).json() == []
 
 
-def test_a_drive_without_recorder_is_refused(tmp_path, sim_opener):
+def test_a_drive_without_recorder_captures_through_tpdos_and_states_rate_and_bus_load(tmp_path, sim_opener):
     app = admin_app(Settings(projects_dir=tmp_path, static_dir=tmp_path / "no-ui", buses=[]), tmp_path / "data")
     with api_client(app) as client:
         sim_opener(app.state.server.connections, "sim:1:cd1k")
         bus = app.state.server.connections.list()[0].id
-        answer = client.get(f"/api/buses/{bus}/nodes/1/scope")
-        assert answer.status_code == 422 and "no recorder: TPDO capture comes later" in answer.json()["detail"]
+        scope = f"/api/buses/{bus}/nodes/1/scope"
+        info = client.get(scope).json()
+        assert (info["source"], info["capacity"], info["base_period_ns"]) == ("tpdo", None, 1_000_000)
+        definition = {"channels": ["0x6064,0", "0x6041,0"], "period_us": 1000, "samples": 100}
+        plan = client.post(f"{scope}/check", json=definition).json()
+        assert plan["source"] == "tpdo" and plan["multiplier"] is None
+        stream = plan["stream"]
+        assert stream["rate_hz"] == 1000 and stream["frames_per_s"] == 2000 and stream["bitrate_assumed"] is True
+        assert stream["bus_load"] == pytest.approx((47 + 48 + (34 + 48 - 1) // 4 + 55) / 1000)  # 6 bytes + SYNC
+        refused = client.post(f"{scope}/check", json={**definition, "period_us": 250})
+        assert refused.status_code == 422 and "every 1000 µs at the fastest" in refused.json()["detail"]
+        job = finished(client, client.post(f"{scope}/captures", json=definition).json())
+        assert job["state"] == "done", job
+        made = client.get(f"{scope}/captures/{job['result']['capture']}").json()
+        assert made["source"] == "tpdo" and made["samples"] == 100 and made["alignment_ns"] is not None
+        assert "# source: tpdo" in client.get(f"{scope}/captures/{job['result']['capture']}/csv").text
+        assert client.get(f"{scope}/status").json() == {"status": "idle", "counter": 0, "job": None}

@@ -55,6 +55,7 @@ def test_backup_into_the_project_then_checklist_and_compare(page: Page, demo_ser
     axis, node = demo_server.axes[2]
     page.goto(f"{demo_server.url}/projects/demo/axes/{axis}/backup")
     page.get_by_test_id("backup-to-project").click()
+    page.get_by_test_id("confirm").click()  # the summary of what changes (tests/browser/test_first_use_backup.py)
     expect(page.get_by_test_id("backup-result")).to_contain_text(f"of node {node} stored in project demo")
     screenshot(page, "backup")
     rows = demo_server.api("GET", f"/api/projects/demo/axes/{axis}/parameters?only_set=true").json()["parameters"]
@@ -88,3 +89,17 @@ def test_archive_and_import_under_a_new_name(page: Page, demo_server: DemoServer
     expect(page.get_by_test_id("project-title")).to_have_text("demo-restored")
     restored = demo_server.api("GET", "/api/projects/demo-restored").json()
     assert [a["name"] for a in restored["axes"]] == [name for name, _node in demo_server.axes]
+
+
+def test_a_scan_that_finds_nothing_says_so_and_why(page: Page, demo_server: DemoServer) -> None:
+    """#14 point 13: an empty bus is an answer, with the reasons the server gives for its kind (X-Scan-Hint)."""
+    page.goto(demo_server.url + "/")
+    page.get_by_role("link", name="Bus and scan").click()
+    page.get_by_test_id("bus-spec").fill("virtual:nobody-here")
+    page.get_by_test_id("bus-id").fill("empty")
+    page.get_by_test_id("bus-connect").click()
+    page.get_by_test_id("scan-empty").click()
+    hint = page.get_by_test_id("scan-hint")
+    expect(hint).to_contain_text("No node answered on empty.")
+    expect(hint).to_contain_text("virtual")  # the hint for a virtual channel: another process's channel is not this one
+    demo_server.api("DELETE", "/api/buses/empty")

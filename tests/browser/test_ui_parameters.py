@@ -24,6 +24,7 @@ def test_kpv_found_changed_on_the_drive_and_persisted(page: Page, demo_server: D
     ).json()["raw"]
     expect(page.get_by_test_id("detail-drive-value")).to_have_text(str(before))
     new_value = before + 111 if before < 60000 else before - 111
+    page.get_by_test_id("target-both").check()  # an edit goes to the project only unless the drive is chosen
     editor = page.get_by_test_id("param-editor")
     editor.fill(str(new_value))
     page.get_by_test_id("param-write").click()
@@ -49,6 +50,7 @@ def test_decimal_point_in_a_german_browser_and_the_server_range_check(page: Page
     axis, node = demo_server.axes[2]
     page.goto(f"{demo_server.url}/projects/demo/axes/{axis}/parameters?q=0x6075")
     page.locator('.prow.entry[data-address="0x6075"]').click()
+    page.get_by_test_id("target-drive").check()
     editor = page.get_by_test_id("param-editor")
     editor.fill("2,5")
     editor.press("Enter")
@@ -76,6 +78,7 @@ def test_only_differences_then_write_changed_to_the_drive(page: Page, demo_serve
     expect(row.locator('[data-col="drive"] .differs')).to_be_visible()
     screenshot(page, "parameters-differences")
     page.get_by_test_id("param-write-changed").click()
+    page.get_by_test_id("confirm").click()  # the list of what is written (tests/browser/test_first_use_editor.py)
     expect(page.get_by_test_id("toast").last).to_contain_text("written to the drive")
     assert demo_server.api("GET", drive_path).json()["raw"] == wanted
     expect(row.locator('[data-col="drive"]')).to_have_text(str(wanted))

@@ -119,7 +119,7 @@ def test_refused_before_anything_is_armed_exit_3_and_no_file(tmp_path, capsys, a
     assert reason in capsys.readouterr().err and not out.exists()
 
 
-def test_trigger_and_immediate_exclude_each_other_and_server_is_not_yet_supported(tmp_path):
+def test_trigger_and_immediate_exclude_each_other_and_an_unreachable_server_is_exit_5(tmp_path):
     both = run("--bus", "sim:1", "--node", "1", "--ch", "0x6041", "--immediate", "--trigger", "0x6041:rising:1",
                "--out", str(tmp_path / "x.csv"))  # fmt: skip
     assert both.returncode == 2 and "not allowed with argument" in both.stderr
@@ -128,7 +128,7 @@ def test_trigger_and_immediate_exclude_each_other_and_server_is_not_yet_supporte
          "1", "--ch", "0x6041", "--out", str(tmp_path / "x.csv")],
         capture_output=True, text=True, cwd=REPO, timeout=60,
     )  # fmt: skip
-    assert remote.returncode == 3 and "does not work through --server yet" in remote.stderr
+    assert remote.returncode == 5 and "cannot be reached" in remote.stderr and not (tmp_path / "x.csv").exists()
 
 
 def test_no_recording_in_time_exit_5_and_no_file(tmp_path, capsys, socketcand, peer):
@@ -159,3 +159,28 @@ def test_a_link_cut_during_the_upload_exit_5_no_file_and_the_next_capture_works(
     assert not out.exists() and not list(tmp_path.iterdir())  # not even a temporary file
     short = [*arguments[:-8], "--samples", "64", "--out", str(out)]
     assert main(short) == 0 and out.exists()
+
+
+def test_plan_states_rate_and_bus_load_and_arms_nothing(tmp_path, capsys):
+    code = main(["scope", "--bus", "sim:1,2:cd1k", "--node", "2", "--ch", "0x6064,0", "--ch", "0x6064,0@1",
+                 "--period-us", "2000", "--plan"])  # fmt: skip
+    assert code == 0, capsys.readouterr().err
+    plan = json.loads(capsys.readouterr().out)
+    assert plan["source"] == "tpdo" and [channel["key"] for channel in plan["channels"]] == ["0x6064,0", "0x6064,0@1"]
+    stream = plan["stream"]
+    assert stream["rate_hz"] == 500 and stream["nodes"] == [2, 1] and stream["frames_per_s"] == 1500
+    assert stream["bus_load"] == pytest.approx((2 * 95 + 55) / 2000)  # two 4-byte TPDOs (95 bits) and the SYNC (55)
+    assert "same SYNC frame" in stream["alignment"]
+
+
+def test_a_cd1k_capture_through_tpdos_with_a_second_axis(tmp_path, capsys):
+    out = tmp_path / "two.csv"
+    code = main(["scope", "--bus", "sim:1,2:cd1k", "--node", "2", "--ch", "0x6041,0", "--ch", "0x6041,0@1",
+                 "--period-us", "1000", "--samples", "50", "--out", str(out)])  # fmt: skip
+    assert code == 0, capsys.readouterr().err
+    summary = json.loads(capsys.readouterr().out)
+    assert summary["source"] == "tpdo" and summary["channels"] == ["0x6041,0", "0x6041,0@1"]
+    text = out.read_text()
+    assert "# source: tpdo" in text and 'time_s,"0x6041,0","0x6041,0@1"' in text
+    rows = list(csv.reader(line for line in text.splitlines() if not line.startswith("# ")))
+    assert len(rows) == 51 and [row[0] for row in rows[1:3]] == ["0", "0.001"]

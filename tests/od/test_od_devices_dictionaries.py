@@ -27,8 +27,11 @@ EDS_DIR = REPO / "eds"
 MANUALS = Path(os.environ["SERVOSTUDIO_MANUALS"]) if os.environ.get("SERVOSTUDIO_MANUALS") else None
 NO_MANUALS = "set SERVOSTUDIO_MANUALS to the directory of the manuals' text editions"
 DEVICES = ("cd1k", "encotrive")
+PROJECT_OBJECTS = {0x3428}
+"""Objects the project defines on top of the manual (0x3428 "Identified plant", issue #13's contract): referenced to
+docs/, not to a manual line."""
 
-CD1K_INDICES = {
+CD1K_INDICES = PROJECT_OBJECTS | {
     0x1000,
     0x1001,
     0x1005,
@@ -394,6 +397,9 @@ def test_every_entry_has_a_group_and_a_line_reference(device: str) -> None:
     for var in od.variables():
         where = f"0x{var.index:04X},{var.subindex}"
         assert var.group, where
+        if var.index in PROJECT_OBJECTS:
+            assert var.reference.startswith("docs/"), where
+            continue
         assert var.reference.startswith("L") and var.reference[1:].isdigit(), where
 
 
@@ -401,6 +407,8 @@ def test_every_entry_has_a_group_and_a_line_reference(device: str) -> None:
 def test_cd1k_references_point_at_the_objects_lines(cd1k) -> None:
     lines = (MANUALS / "001_c18fe7dc514993d8.txt").read_text(encoding="utf-8").splitlines()
     for var in cd1k.variables():
+        if var.index in PROJECT_OBJECTS:
+            continue
         line = lines[int(var.reference[1:]) - 1]
         sub = var.subindex
         on_topic = (

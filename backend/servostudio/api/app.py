@@ -25,14 +25,18 @@ from servostudio.api.routes import (
     drives,
     events,
     health,
+    motion,
+    procedures,
     projects,
     scope,
+    sequences,
     users,
 )
 from servostudio.api.security import BrowserOrigin, OriginPolicy
 from servostudio.api.state import ServerState
 from servostudio.api.ui import mount_ui
 from servostudio.errors import ErrorKind
+from servostudio.services.sequences import SequenceMonitors
 from servostudio.services.settings import Settings
 
 __all__ = ["Settings", "create_app"]
@@ -54,7 +58,23 @@ def create_app(settings: Settings | None = None) -> FastAPI:
         responses=error_responses(ErrorKind.INVALID_INPUT, ErrorKind.INTERNAL),
     )
     app.state.server = state
-    for router in (health, users, dictionaries, projects, buses, drives, control, backup, scope, events, audit):
+    app.state.sequences = SequenceMonitors()  # the live sequence monitors (routes/sequences.py)
+    for router in (
+        health,
+        users,
+        dictionaries,
+        projects,
+        buses,
+        drives,
+        control,
+        motion,
+        procedures,
+        backup,
+        scope,
+        sequences,
+        events,
+        audit,
+    ):
         app.include_router(router.router, prefix="/api")
     mount_ui(app, state.settings.static_dir)
     return app
@@ -69,4 +89,5 @@ async def _lifespan(app: FastAPI) -> AsyncIterator[None]:
     state.projects.store.remove_stale_temporaries()  # what saves interrupted by a crash left behind
     state.open_buses()
     yield
+    app.state.sequences.close()
     state.close()

@@ -14,6 +14,7 @@ Every HTTP response carries the request id in ``X-Request-ID``.
 from __future__ import annotations
 
 import logging
+import math
 import uuid
 from collections.abc import Callable, Coroutine
 from typing import Any
@@ -28,7 +29,7 @@ from starlette.datastructures import MutableHeaders
 from starlette.exceptions import HTTPException
 from starlette.types import ASGIApp, Message, Receive, Scope, Send
 
-from servostudio.errors import OUTCOMES, ErrorKind, InvalidInput, ServoStudioError
+from servostudio.errors import OUTCOMES, ErrorKind, InvalidInput, RateLimited, ServoStudioError
 
 REQUEST_ID_HEADER = "X-Request-ID"
 log = logging.getLogger(__name__)
@@ -69,7 +70,14 @@ def error_responses(*kinds: ErrorKind) -> dict[int | str, dict[str, Any]]:
 
 
 async def _refused(request: Request, error: ServoStudioError) -> JSONResponse:
-    return JSONResponse(error_body(error), status_code=error.outcome.http_status)
+    return JSONResponse(error_body(error), status_code=error.outcome.http_status, headers=_retry_after(error))
+
+
+def _retry_after(error: ServoStudioError) -> dict[str, str]:
+    """A rate-limited caller learns when to retry (RFC 9110 §10.2.3: whole seconds)."""
+    if isinstance(error, RateLimited):
+        return {"Retry-After": str(max(1, math.ceil(error.retry_after)))}
+    return {}
 
 
 async def _malformed(request: Request, error: RequestValidationError) -> JSONResponse:

@@ -7,7 +7,7 @@ from dataclasses import dataclass, field
 
 from servostudio.od import EdsLibrary
 from servostudio.services.audit import AuditLog
-from servostudio.services.bus import ConnectionManager, EventHub, JobRegistry
+from servostudio.services.bus import ConnectionManager, EventHub, JobRegistry, parse_share
 from servostudio.services.motion import MotionGuard
 from servostudio.services.projects import ProjectService
 from servostudio.services.scope import ScopeService
@@ -52,6 +52,8 @@ class ServerState:
         """The buses the server was started with (they connect in the background; a missing one retries)."""
         for spec in self.settings.buses:
             self.connections.open(spec, wait=0.0)
+        for share in self.settings.shares:  # the user's opt-in, per bus (``serve --share BUS=PORT``)
+            self.connections.share(*parse_share(share))
 
     def close(self) -> None:
         self.connections.close_all()

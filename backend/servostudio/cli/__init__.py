@@ -11,11 +11,15 @@ import os
 import sys
 from pathlib import Path
 
-from servostudio.cli import audit, drive, eds, project, remote, token, user
+from servostudio.cli import audit, drive, eds, project, remote, seq, token, user
+from servostudio.cli import motion as motion_cli
+from servostudio.cli import procedures as procedures_cli
 from servostudio.cli import scope as scope_cli
 from servostudio.cli import sim as sim_cli
 from servostudio.cli.output import crashed, refused
 from servostudio.errors import ServoStudioError
+from servostudio.services.bus import parse_share
+from servostudio.services.bus.share import loopback
 from servostudio.services.settings import DEFAULT_HOST, DEFAULT_PORT, Settings
 from servostudio.services.users import RemoteBindRefused, UserStore, check_bind
 
@@ -32,7 +36,10 @@ def build_parser() -> argparse.ArgumentParser:
     eds.register(commands)
     project.register(commands)
     drive.register(commands)
+    motion_cli.register(commands)
+    procedures_cli.register(commands)
     scope_cli.register(commands)
+    seq.register(commands)
     audit.register(commands)
     sim_cli.register(commands)
     return parser
@@ -90,6 +97,14 @@ def _add_serve(commands: argparse._SubParsersAction) -> None:
         metavar="SPEC",
         help="bus to open at startup, repeatable (default: sim, the embedded simulated drives)",
     )
+    serve.add_argument(
+        "--share",
+        action="append",
+        default=[],
+        metavar="BUS=[HOST:]PORT",
+        help="share an open bus as a socketcand endpoint for your own CANopen scripts, e.g. sim=29540 (loopback "
+        "only; repeatable)",
+    )
     serve.set_defaults(handler=_serve)
 
 
@@ -109,6 +124,7 @@ def _serve(args: argparse.Namespace) -> int:
         export_dir=args.export_dir,
         static_dir=args.ui,
         buses=tuple(args.bus or ["sim"]),
+        shares=tuple(args.share),
         host=args.host,
         port=args.port,
         data_dir=args.data_dir,
@@ -116,6 +132,8 @@ def _serve(args: argparse.Namespace) -> int:
         allowed_origins=tuple(args.allowed_origin),
     )
     check_bind(settings.host, args.allow_remote, UserStore(settings.data_dir))
+    for share in settings.shares:  # refused before the server starts (exit 3), not in its lifespan
+        loopback(parse_share(share)[1])
     uvicorn.run(
         create_app(settings),
         host=settings.host,

@@ -1,6 +1,8 @@
 """Drive commands: ``servostudio scan|read|write|backup|restore|nmt|fault|state --bus SPEC [--node N] …``.
 
-Each command opens the bus, does its work, prints JSON on stdout and exits with the code of what went wrong
+Through a running server (``--server URL``, ``$SERVOSTUDIO_SERVER`` or the config file: ``cli.remote``) each
+command is the server's REST calls (``cli.server_drive``); with ``--bus`` alone it opens the bus itself (headless).
+Here each command opens the bus, does its work, prints JSON on stdout and exits with the code of what went wrong
 (the kind of the error, see ``servostudio.cli.output``): 3 refused (nothing written), 4 unknown node/object or a
 scan that found no node, 5 communication.
 """
@@ -14,12 +16,14 @@ import threading
 from collections.abc import Callable, Sequence
 from pathlib import Path
 
+from servostudio.cli import remote, server_drive
 from servostudio.cli.audit import audit_log, guarded_connections, local_actor
 from servostudio.cli.output import emit
 from servostudio.drive.access import Drive
 from servostudio.drive.cia402 import State
 from servostudio.drive.control import fault_report, read_state, reset_faults, set_state
 from servostudio.drive.link import LinkDownError
+from servostudio.errors import InvalidInput
 from servostudio.services.audit import acting_as
 from servostudio.services.backup import (
     BackupError,
@@ -38,64 +42,101 @@ from servostudio.services.transfers import FileResult, per_node
 CONNECT_WAIT = 3.0
 
 
+Handler = Callable[[argparse.Namespace, BusConnection], object]
+ServerHandler = Callable[[argparse.Namespace, server_drive.ServerBus], object]
+
+
 def register(commands: argparse._SubParsersAction) -> None:
     def add(
-        name: str, help_text: str, handler: Callable[[argparse.Namespace, BusConnection], object], node: str = "one"
+        name: str, help_text: str, handler: Handler, through_server: ServerHandler, node: str = "one"
     ) -> argparse.ArgumentParser:
         parser = commands.add_parser(name, help=help_text)
         parser.add_argument(
             "--bus",
-            required=True,
             metavar="SPEC",
-            help="e.g. socketcand:127.0.0.1:29536, serial:/dev/ttyUSB0@19200, socketcan:can0, sim",
+            help="the bus to open here, e.g. socketcand:127.0.0.1:29536, serial:/dev/ttyUSB0@19200, socketcan:can0, "
+            "sim; with --server the server's bus (name or spec; default: its only bus)",
         )
+        remote.add_options(parser, suppress=True)
         if node == "one":
             parser.add_argument("--node", type=int, required=True, help="node ID 1..127")
             parser.add_argument("--device", help="device key when the node does not identify itself")
         elif node == "many":
             parser.add_argument("--node", type=int, action="append", help="node ID, repeatable (default: scan)")
             parser.add_argument("--device", help="device key of the given nodes when they do not identify themselves")
-        parser.set_defaults(handler=lambda args: _run(args, handler))
+        parser.set_defaults(handler=lambda args: _run(args, parser, handler, through_server))
         return parser
 
-    add("scan", "find and identify the nodes of a bus", _scan, node="none")
-    read = add("read", "read objects of a node", _read)
+    add("scan", "find and identify the nodes of a bus", _scan, server_drive.scan, node="none")
+    read = add("read", "read objects of a node", _read, server_drive.read)
     read.add_argument("objects", nargs="+", metavar="OBJECT", help="0x6041, 0x60F9,2, a name, or statusword")
-    write = add("write", "write an object of a node (checked before anything is sent)", _write)
+    write = add("write", "write an object of a node (checked before anything is sent)", _write, server_drive.write)
     write.add_argument("object", metavar="OBJECT")
     write.add_argument("value", metavar="VALUE", help="number, 0x hex, enumeration label or text")
     write.add_argument("--physical", action="store_true", help="VALUE is in the object's unit")
-    backup = add("backup", "back up drive files (DRIVEPAR.TXT, USER_PAR.TXT, SEQUENCE.TXT)", _backup, node="many")
+    backup = add(
+        "backup",
+        "back up drive files (DRIVEPAR.TXT, USER_PAR.TXT, SEQUENCE.TXT)",
+        _backup,
+        server_drive.backup,
+        node="many",
+    )
     backup.add_argument(
         "--out",
         type=Path,
         required=True,
         help="file (one node: kind from its name) or directory (DIR/node<N>/ per node)",
     )
-    restore = add("restore", "validate, write, verify and store drive files", _restore, node="many")
+    restore = add(
+        "restore", "validate, write, verify and store drive files", _restore, server_drive.restore, node="many"
+    )
     restore.add_argument("--in", dest="source", type=Path, required=True, help="file (one node) or directory")
     restore.add_argument("--no-store", action="store_true", help="do not store to flash afterwards")
-    nmt = add("nmt", "send an NMT command", _nmt, node="none")
+    nmt = add("nmt", "send an NMT command", _nmt, server_drive.nmt, node="none")
     nmt.add_argument(
         "command_name", metavar="COMMAND", help="start, stop, pre-operational, reset-node, reset-communication"
     )
     nmt.add_argument("--node", type=int, default=0, help="node ID (default 0: all nodes)")
-    fault = add("fault", "show active faults with the manual's remedy; --reset resets them", _fault)
+    fault = add("fault", "show active faults with the manual's remedy; --reset resets them", _fault, server_drive.fault)
     fault.add_argument("--reset", action="store_true")
     state = add(
         "state",
         "show the CiA 402 state, or walk to TARGET (operation-enabled holds the axis enabled "
         "until the command is interrupted, then quick-stops it)",
         _state,
+        server_drive.state,
     )
     state.add_argument(
         "target",
         nargs="?",
         help="switch-on-disabled, ready-to-switch-on, switched-on, operation-enabled, quick-stop-active",
     )
+    share = add(
+        "share",
+        "share a bus of the running server as a socketcand endpoint for your own CANopen scripts (loopback only)",
+        _share_here,
+        server_drive.share,
+        node="none",
+    )
+    share.add_argument("--port", type=int, default=0, help="TCP port (default 0: any free port, printed)")
+    share.add_argument("--host", default="127.0.0.1", help="loopback address to bind (default 127.0.0.1)")
+    share.add_argument("--off", action="store_true", help="stop sharing the bus")
 
 
-def _run(args: argparse.Namespace, handler: Callable[[argparse.Namespace, BusConnection], object]) -> int:
+def _run(
+    args: argparse.Namespace, parser: argparse.ArgumentParser, handler: Handler, through_server: ServerHandler
+) -> int:
+    """Through the server the command names (``--server``, or the default of ``cli.remote``), or on the bus it
+    names (``--bus``, headless)."""
+    server = remote.Remote.of(args)
+    if server is not None:
+        return emit(through_server(args, server_drive.ServerBus.of(server, args)))
+    if args.bus is None:
+        parser.error(f"--bus SPEC is needed (or --server URL, ${remote.SERVER_VARIABLE}, or a config file)")
+    return _run_here(args, handler)
+
+
+def _run_here(args: argparse.Namespace, handler: Handler) -> int:
     """Open the bus, run the command on it as the person at the terminal (through the motion guard, recorded in
     the audit log), close it; errors go to ``main``, which exits with their kind's code."""
     manager = guarded_connections(audit_log())
@@ -108,6 +149,15 @@ def _run(args: argparse.Namespace, handler: Callable[[argparse.Namespace, BusCon
             return emit(handler(args, connection))
     finally:
         manager.close_all()
+
+
+class ShareNeedsServer(InvalidInput):
+    """``share`` shares a bus of a running server; this process would stop sharing when it ends."""
+
+
+def _share_here(args: argparse.Namespace, connection: BusConnection) -> object:
+    raise ShareNeedsServer("share works on a running server's bus: give --server URL (or start the server with "
+                           "servostudio serve --share BUS=PORT)")  # fmt: skip
 
 
 def _drive(args: argparse.Namespace, connection: BusConnection, node: int | None = None) -> Drive:
@@ -164,7 +214,7 @@ def _restore(args: argparse.Namespace, connection: BusConnection) -> object:
         result = restore_file(drives[0], source, store=store)
         if not result.ok:
             emit(result.as_dict())
-            raise BackupError(_restore_failure(result.as_dict()))
+            raise BackupError(restore_failure(result.as_dict()))
         return result.as_dict()
     return _collect(
         run_per_drive(drives, lambda drive: restore_drive(drive, source / f"node{drive.node}", store=store))
@@ -191,7 +241,8 @@ def _failure(node: int, outcome: Sequence[FileResult] | Exception) -> Exception 
     return None
 
 
-def _restore_failure(result: dict) -> str:
+def restore_failure(result: dict) -> str:
+    """Why a restore is incomplete, as the command reports it (here or through a server)."""
     problems = result.get("objects") or []
     detail = "; ".join(f"{item['label']}: {item['status']} {item['error']}".strip() for item in problems[:5])
     return f"restore of node {result['node']} incomplete: {result.get('error') or detail}"

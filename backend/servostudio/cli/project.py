@@ -8,6 +8,7 @@ motor, template); 5 communication (bus not connected, drive not answering, value
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import functools
 from pathlib import Path
 
@@ -132,6 +133,9 @@ def register(commands: argparse._SubParsersAction) -> None:
     compare.add_argument("--group")
     compare.add_argument("--only-differences", action="store_true")
     compare.add_argument("--drive", action="store_true", help="add the live drive's values (opens the axis's bus)")
+    compare.add_argument(
+        "--read-only", action="store_true", help="also the read-only entries, apart (key read_only; never counted)"
+    )
     via(compare)
     take = action("take", _take, "store the drive's values in the project (default: every differing object)")
     take.add_argument("name")
@@ -189,6 +193,13 @@ def register(commands: argparse._SubParsersAction) -> None:
     dcf_import.add_argument("axis")
     dcf_import.add_argument("dcf", type=Path)
     revision(dcf_import)
+    action(
+        "revisions", _revisions, "kept revisions: the project before each change that replaced many values"
+    ).add_argument("name")
+    restore = action("revision-restore", _revision_restore, "make the project what it was at a kept revision")
+    restore.add_argument("name")
+    restore.add_argument("kept", metavar="REVISION", help="a kept revision (see `revisions`)")
+    revision(restore)
 
     action("motor-list", _motor_list, "motors of the catalog")
     motor_add = action("motor-add", _motor_add, "add a motor file to the user catalog")
@@ -342,16 +353,32 @@ def _compare(service: ProjectService, args: argparse.Namespace) -> dict:
         rows, revision = service.parameters.compare(
             args.name, args.axis, group=args.group, only_differences=args.only_differences
         )
-        return {"columns": ["project", "default"], "rows": [compare_view(row) for row in rows], "revision": revision}
+        apart = service.parameters.read_only(args.name, args.axis, group=args.group) if args.read_only else []
+        result = {"columns": ["project", "default"], "rows": [compare_view(row) for row in rows], "revision": revision}
+        return result | ({"read_only": [compare_view(row) for row in apart]} if args.read_only else {})
     live = _live(service, args).compare(
-        args.name, args.axis, group=args.group, only_differences=args.only_differences, buses=_via(args)
+        args.name,
+        args.axis,
+        group=args.group,
+        only_differences=args.only_differences,
+        buses=_via(args),
+        read_only=args.read_only,
     )
-    return {
+    result = {
         "columns": ["drive", "project", "default"],
         "rows": [compare_view(row) for row in live.rows],
         "revision": live.revision,
         "refused": live.refused,
     }
+    return result | ({"read_only": [compare_view(row) for row in live.read_only]} if args.read_only else {})
+
+
+def _revisions(service: ProjectService, args: argparse.Namespace) -> list[dict]:
+    return [dataclasses.asdict(item) for item in service.revisions(args.name)]
+
+
+def _revision_restore(service: ProjectService, args: argparse.Namespace) -> dict:
+    return project_view(service.restore_revision(args.name, args.kept, args.revision))
 
 
 def _take(service: ProjectService, args: argparse.Namespace) -> dict:

@@ -6,9 +6,15 @@ Pinned for scripts (issue #12)::
         [--trigger OBJ:rising|falling|either:LEVEL | --immediate] [--pretrigger PCT] [--timeout S]
         --out FILE.csv [--html FILE.html]
 
+and, for drives without a recorder and several axes (docs/scope.md §7): ``--ch OBJ@NODE`` (a channel of another
+axis of the bus), ``--source auto|recorder|tpdo|poll``, and ``--plan`` (print the plan — source, rate, bus load,
+alignment — and arm nothing).
+
 The files are the capture service's (docs/scope.md): written only once the recording is read completely, each
 atomically, so a failed capture leaves none. Stdout gets a JSON summary; the exit code is the error's kind (3 refused
 before anything was armed, 4 unknown node or object, 5 the bus or the drive failed or no recording in time).
+With ``--server URL`` the server captures on its bus (``--bus`` names it, or its spec; default: its only bus) and
+the files are written here the same way (``cli/scope_remote.py``).
 """
 
 from __future__ import annotations
@@ -19,10 +25,13 @@ import sys
 import threading
 from collections.abc import Callable
 from pathlib import Path
+from typing import TypeVar
 
+from servostudio.api.routes.scope_models import plan_model
+from servostudio.cli import remote, scope_remote
 from servostudio.cli.output import emit
+from servostudio.cli.server_drive import ServerBus
 from servostudio.drive.link import LinkDownError
-from servostudio.errors import InvalidInput
 from servostudio.formats.textfile import write_bytes_atomic
 from servostudio.services.bus import ConnectionManager
 from servostudio.services.cancel import Cancellation, Cancelled
@@ -34,26 +43,33 @@ from servostudio.services.scope import (
     capture,
     capture_csv,
     capture_html,
+    check,
     identity_of,
     parse_trigger,
 )
-from servostudio.services.scope.definition import DEFAULT_PERIOD_US, DEFAULT_SAMPLES
+from servostudio.services.scope.definition import DEFAULT_PERIOD_US, DEFAULT_SAMPLES, SOURCES
 
+T = TypeVar("T")
 CONNECT_WAIT = 3.0
 DEFAULT_TIMEOUT_S = 10.0
 EXIT_INTERRUPTED = 130  # the shell's code for a command ended by Ctrl-C
 
 
-class RemoteScopeUnavailable(InvalidInput):
-    """``--server`` does not reach the recorder yet: the CLI opens the bus itself."""
-
-
 def register(commands: argparse._SubParsersAction) -> None:
-    parser = commands.add_parser("scope", help="capture up to 4 signals with the drive's recorder into a CSV file")
-    parser.add_argument("--bus", required=True, metavar="SPEC", help="e.g. socketcand:127.0.0.1:29536, sim")
+    parser = commands.add_parser("scope", help="capture signals of one or several axes into a CSV file")
+    parser.add_argument(
+        "--bus",
+        metavar="SPEC",
+        help="e.g. socketcand:127.0.0.1:29536, sim; with --server the server's bus (default: its only bus)",
+    )
+    remote.add_options(parser, suppress=True)
     parser.add_argument("--node", type=int, required=True, help="node ID 1..127")
     parser.add_argument(
-        "--ch", action="append", required=True, metavar="OBJ", help="channel: 0x606C,0, a name or statusword"
+        "--ch",
+        action="append",
+        required=True,
+        metavar="OBJ",
+        help="channel: 0x606C,0, a name or statusword; OBJ@NODE for another axis of the bus",
     )
     parser.add_argument("--period-us", type=float, default=DEFAULT_PERIOD_US, help="sample period (default 250 µs)")
     parser.add_argument("--samples", type=int, default=DEFAULT_SAMPLES, help="samples per channel (default 2048)")
@@ -62,9 +78,13 @@ def register(commands: argparse._SubParsersAction) -> None:
     trigger.add_argument("--immediate", action="store_true", help="record from the arm (the default)")
     parser.add_argument("--pretrigger", type=float, default=0.0, metavar="PCT", help="share before the trigger, %%")
     parser.add_argument("--timeout", type=float, default=DEFAULT_TIMEOUT_S, metavar="S", help="wait for the recording")
-    parser.add_argument("--out", type=Path, required=True, metavar="FILE.csv")
+    parser.add_argument(
+        "--source", choices=SOURCES, default="auto", help="recorder, TPDOs at the server's SYNC, or polling"
+    )
+    parser.add_argument("--plan", action="store_true", help="print the capture's plan (rate, bus load) and arm nothing")
+    parser.add_argument("--out", type=Path, metavar="FILE.csv")
     parser.add_argument("--html", type=Path, metavar="FILE.html", help="also a standalone interactive HTML file")
-    parser.set_defaults(handler=_scope)
+    parser.set_defaults(handler=lambda args: _scope(args, parser))
 
 
 def definition_of(args: argparse.Namespace) -> CaptureDefinition:
@@ -75,13 +95,19 @@ def definition_of(args: argparse.Namespace) -> CaptureDefinition:
         trigger=parse_trigger(args.trigger) if args.trigger else Trigger(),
         pre_trigger_pct=args.pretrigger,
         timeout_s=args.timeout,
+        source=args.source,
     )
 
 
-def _scope(args: argparse.Namespace) -> int:
-    if getattr(args, "server", None):
-        raise RemoteScopeUnavailable("scope does not work through --server yet; name the bus with --bus")
-    definition = definition_of(args)  # refused before the bus is opened
+def _scope(args: argparse.Namespace, parser: argparse.ArgumentParser) -> int:
+    if args.out is None and not args.plan:
+        parser.error("--out FILE.csv is needed (or --plan)")
+    definition = definition_of(args)  # refused before the bus (or the server) is asked
+    server = remote.Remote.of(args)
+    if server is not None:
+        return _through_server(args, ServerBus.of(server, args), definition)
+    if args.bus is None:
+        parser.error("--bus SPEC is needed (or --server URL)")
     manager = ConnectionManager()
     try:
         connection = manager.open(args.bus, wait=CONNECT_WAIT)
@@ -89,8 +115,12 @@ def _scope(args: argparse.Namespace) -> int:
             raise LinkDownError(f"bus {args.bus}: not connected ({connection.link.last_error or 'no answer'})")
         identified(connection, args.node)
         drive = connection.drive(args.node)
+        bitrate = connection.spec.bitrate
+        if args.plan:
+            return emit(plan_model(check(drive, definition, connection.drive, bitrate)).model_dump())
         made = _interruptible(lambda cancellation: capture(drive, identity_of(connection, drive), definition,
-                                                           cancellation=cancellation))  # fmt: skip
+                                                           cancellation=cancellation, axes=connection.drive,
+                                                           bitrate=bitrate))  # fmt: skip
     except Cancelled as stopped:
         print(f"error: {stopped}; the recorder was stopped", file=sys.stderr)
         return EXIT_INTERRUPTED
@@ -99,7 +129,20 @@ def _scope(args: argparse.Namespace) -> int:
     return emit(_write(made, args.out, args.html))
 
 
-def _interruptible(work: Callable[[Cancellation], Capture]) -> Capture:
+def _through_server(args: argparse.Namespace, bus: ServerBus, definition: CaptureDefinition) -> int:
+    if args.plan:
+        return emit(bus.call("POST", bus.path(args.node, "/scope/check"), definition.as_dict()))
+    try:
+        made = _interruptible(
+            lambda cancellation: scope_remote.capture_through(bus, args.node, definition, cancellation)
+        )
+    except Cancelled as stopped:
+        print(f"error: {stopped}; the recorder was stopped", file=sys.stderr)
+        return EXIT_INTERRUPTED
+    return emit(scope_remote.write_files(bus, args.node, made, args.out, args.html))
+
+
+def _interruptible(work: Callable[[Cancellation], T]) -> T:
     """Run ``work(cancellation)``; Ctrl-C or SIGTERM cancels it (the service then stops the recorder). Signals reach
     only the main thread: a command run from another thread (an embedding program) just runs."""
     cancellation = Cancellation()
@@ -127,4 +170,6 @@ def _write(made: Capture, out: Path, html: Path | None) -> dict[str, object]:
         "trigger": made.trigger,
         "trigger_index": made.trigger_index,
         "captured": made.captured_at,
+        "source": made.source,
+        "alignment_ns": made.alignment_ns,
     }

@@ -41,3 +41,17 @@ def send_nmt(link: BusLink, command: NmtCommand, node: int = 0) -> None:
     if not 0 <= node <= 127:
         raise InvalidInput(f"node ID {node} outside 0..127 (0 = all nodes)")
     link.send(0x000, bytes([int(command), node]))
+
+
+#: what an SDO answer proves: a STOPPED or initialising node answers no SDO (CiA 301 §7.3.2.2)
+ANSWERS_SDO = "PRE-OPERATIONAL or OPERATIONAL"
+
+
+def known_nmt_state(announced: str | None, answered_sdo: bool) -> dict[str, str | None]:
+    """What is known of a node's NMT state, and from what: its own heartbeat or boot-up (exact), else an SDO answer
+    (at least pre-operational), else nothing.  A heartbeat saying STOPPED is stale once the node answers SDO."""
+    if announced is not None and not (answered_sdo and announced in ("STOPPED", "INITIALISING")):
+        return {"nmt_state": announced, "nmt_source": "heartbeat", "nmt_text": announced}
+    if answered_sdo:
+        return {"nmt_state": None, "nmt_source": "sdo", "nmt_text": f"{ANSWERS_SDO} (answers SDO; no heartbeat seen)"}
+    return {"nmt_state": None, "nmt_source": None, "nmt_text": "unknown (no heartbeat, no SDO answer)"}

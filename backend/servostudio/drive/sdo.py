@@ -23,12 +23,18 @@ would mix values from before and after it.
 Every transfer ends by itself — answer, abort, timeout, link lost, bus closed — so a future never stays pending;
 waits on futures are still bounded (`settle`, `TransferBatch.outcomes`), as a safety net against a stuck reader.
 
-Block transfers are not used: the dictionaries' values fit in one expedited frame or a few segments, where a
-block transfer needs more frames than a segmented one.
+Large objects (the recorder's buffer, any DOMAIN of kilobytes) are read by block upload (`upload_block`,
+``drive/sdo_block.py``): a block of up to 127 segments per acknowledgement instead of a request per 7 bytes. A node
+that refuses block transfers (abort 0x05040001, or an ordinary upload response: CiA 301's protocol switch) is read
+by segmented upload in the same transfer, and is not asked for a block again until it restarts. Everything else
+stays expedited or segmented: the dictionaries' values fit in one frame or a few segments, where a block transfer
+needs more frames.
 """
 
 from __future__ import annotations
 
+import contextlib
+import logging
 import struct
 import threading
 import time
@@ -39,7 +45,10 @@ from typing import Any, Generic, TypeVar
 
 from servostudio.drive.abort_codes import abort_text
 from servostudio.drive.link import BusLink, LinkDownError
+from servostudio.drive.sdo_block import MAX_BLOCK_SIZE, SEGMENT_BYTES, BlockProtocolError, BlockUpload, Step
 from servostudio.errors import CommunicationError, Conflict, Timeout, Unavailable
+
+log = logging.getLogger(__name__)
 
 SDO_REQUEST = 0x600
 SDO_RESPONSE = 0x580
@@ -52,6 +61,13 @@ UPLOAD_RETRIES = 1  # a read has no side effect: one lost frame should not fail 
 ABORT_TIMEOUT = 0x05040000
 ABORT_COMMAND = 0x05040001
 ABORT_TOGGLE = 0x05030000
+ABORT_STOPPED = 0x08000000  # general error: CiA 301 has no code for "the client gave up"
+#: ``_advance``'s answer when the server sends more before the client answers (the segments of a block)
+_LISTEN = b""
+#: segments between two progress reports of a large upload (one block's worth, block or segmented)
+PROGRESS_SEGMENTS = MAX_BLOCK_SIZE
+#: Safety net of the wait on one large upload: 32 KB by segmented SDO over the 19200-baud RS-232 link take 2 minutes
+LARGE_SAFETY_WAIT = 600.0
 
 #: What a transfer ends with before conversion: the bytes read, or None for a write. The transfer's direction
 #: decides which, so the completions (shared by both directions) take either; the public methods say which.
@@ -84,6 +100,10 @@ class SdoTimeoutError(Timeout, SdoError):
 
 class SdoLinkError(Unavailable, SdoError):
     """The bus went down (or was closed) before or during the transfer."""
+
+
+class SdoStopped(SdoError):
+    """The client stopped a large upload before it completed (``stop()`` said so); the transfer was aborted."""
 
 
 class SdoNodeRestarted(SdoError):
@@ -198,6 +218,8 @@ class _Transfer:
     __slots__ = (
         "abort_on_timeout",
         "answered",
+        "block",
+        "block_size",
         "completion",
         "deadline",
         "download",
@@ -206,11 +228,13 @@ class _Transfer:
         "multiplexer",
         "node",
         "offset",
+        "progress",
         "received",
         "repeated",
         "retries",
         "segmented",
         "slot",
+        "stop",
         "sub",
         "timeout",
         "toggle",
@@ -242,6 +266,21 @@ class _Transfer:
         self.retries = retries  # times the initiate request is sent again when it got no answer at all
         self.answered = False
         self.repeated = False
+        self.block: BlockUpload | None = None  # a block upload while the server goes along
+        self.block_size = 0  # the block size asked (0: no block upload)
+        self.progress: Callable[[int, int | None], None] | None = None
+        self.stop: Callable[[], bool] | None = None
+
+    def large(
+        self, block_size: int, progress: Callable[[int, int | None], None] | None, stop: Callable[[], bool] | None
+    ) -> _Transfer:
+        """This upload as a large one: by block (``block_size`` > 0), with progress reports and a way to stop."""
+        self.block_size, self.progress, self.stop = block_size, progress, stop
+        return self
+
+    @property
+    def received_bytes(self) -> int:
+        return len(self.block.received) if self.block is not None else len(self.received)
 
 
 class _NodeQueue:
@@ -273,11 +312,23 @@ def _stale(transfer: _Transfer, data: bytes) -> bool:
     """An answer that belongs to an earlier request: a late reply about another object (after a timeout), or a
     second reply to a repeated initiate request while the segments are already running."""
     command = data[0]
+    if transfer.block is not None:
+        return _stale_in_block(transfer, data)
     initiate_reply = command >> 5 in (2, 3)
     if (initiate_reply or command == 0x80) and data[1:4] != transfer.multiplexer:
         return True
     in_segments = transfer.offset > 0 if transfer.download is not None else transfer.segmented
     return initiate_reply and in_segments
+
+
+def _stale_in_block(transfer: _Transfer, data: bytes) -> bool:
+    """In a block upload every frame after the initiate response is a segment or the end (neither names the
+    object); only an abort or an initiate response about another object is stale."""
+    assert transfer.block is not None
+    command = data[0]
+    if command == 0x80 or (not transfer.block.started and command >> 5 in (2, 6)):
+        return data[1:4] != transfer.multiplexer
+    return False
 
 
 class SdoEngine:
@@ -290,6 +341,8 @@ class SdoEngine:
         self._queues: dict[int, _NodeQueue] = {}
         self._active: dict[int, _Transfer] = {}
         self._finished: deque[tuple[_Transfer, object]] = deque()  # outcomes to hand over once the lock is free
+        self._reports: deque[tuple[Callable[[int, int | None], None], int, int | None]] = deque()  # progress
+        self._no_block: set[int] = set()  # nodes that refused a block upload (until they restart)
         link.add_ticker(self._check_timeouts)
         link.on_state(self._link_state)
         link.after_dispatch(self._hand_over)  # responses arrive on the reader thread: complete after the batch
@@ -348,6 +401,29 @@ class SdoEngine:
             bulk=True,
         )
         return batch
+
+    def upload_block(
+        self,
+        node: int,
+        index: int,
+        sub: int,
+        timeout: float | None = None,
+        progress: Callable[[int, int | None], None] | None = None,
+        stop: Callable[[], bool] | None = None,
+        block_size: int = MAX_BLOCK_SIZE,
+        bulk: bool = True,
+    ) -> Future:
+        """Read a large object by block upload (segmented where the node refuses blocks); the future gives the
+        bytes. ``progress(received, total)`` runs after each block (total None: not announced), after the bus
+        reader's batch; ``stop()`` is asked at the same moments (on the reader thread: a flag, nothing slow) and
+        ends the transfer with an abort and `SdoStopped`. ``timeout`` is per frame the client waits for.
+        """
+        if not 1 <= block_size <= MAX_BLOCK_SIZE:
+            raise ValueError(f"block size {block_size} outside 1..{MAX_BLOCK_SIZE}")
+        completion = _FutureCompletion(None)
+        transfer = _Transfer(node, index, sub, timeout or self.timeout, completion, retries=UPLOAD_RETRIES)
+        self._submit([transfer.large(0 if node in self._no_block else block_size, progress, stop)], bulk)
+        return completion.future
 
     def download_all(
         self,
@@ -422,6 +498,9 @@ class SdoEngine:
 
     def _initiate(self, transfer: _Transfer) -> bytes:
         data = transfer.download
+        if data is None and transfer.block_size:
+            transfer.block = BlockUpload(transfer.block_size)
+            return transfer.block.initiate(transfer.multiplexer)
         if data is None:
             return bytes([0x40]) + transfer.multiplexer + bytes(4)
         if len(data) <= 4:
@@ -452,7 +531,9 @@ class SdoEngine:
             except SdoError as error:
                 self._finish(transfer, error)
                 follow_up = None
-            if follow_up is None or not self._send(transfer, follow_up):
+            if follow_up is _LISTEN:
+                transfer.deadline = time.monotonic() + transfer.timeout
+            elif follow_up is None or not self._send(transfer, follow_up):
                 self._start_next(node)
 
     def _on_error_control(self, cob_id: int, data: bytes, timestamp: float) -> None:
@@ -461,6 +542,7 @@ class SdoEngine:
             return
         node = cob_id - BOOT_UP
         with self._lock:
+            self._no_block.discard(node)  # the node may be another device (or firmware) now
             void = [self._active.pop(node)] if node in self._active else []
             void += self._queues[node].drain()
             for transfer in void:
@@ -473,10 +555,57 @@ class SdoEngine:
         command = data[0]
         if command == 0x80:
             code = struct.unpack_from("<I", data, 4)[0]
+            if code == ABORT_COMMAND and transfer.block is not None and not transfer.block.started:
+                return self._without_block(transfer)
             raise SdoAbortError(transfer.node, transfer.index, transfer.sub, code)
         if transfer.download is None:
+            if transfer.block is not None:
+                return self._advance_block(transfer, data)
             return self._advance_upload(transfer, command, data)
         return self._advance_download(transfer, command, data)
+
+    def _without_block(self, transfer: _Transfer) -> bytes:
+        """The node refused the block upload: read the object by segmented upload instead (and from now on)."""
+        self._no_block.add(transfer.node)
+        transfer.block, transfer.block_size = None, 0
+        return self._initiate(transfer)
+
+    def _advance_block(self, transfer: _Transfer, data: bytes) -> bytes | None:
+        block = transfer.block
+        assert block is not None
+        try:
+            step = block.on_frame(data, transfer.multiplexer)
+        except BlockProtocolError as error:
+            self._abort(transfer, error.code)
+            raise SdoError(transfer.node, transfer.index, transfer.sub, f"block upload: {error}") from None
+        if step.switched:  # the server answered with an ordinary upload (protocol switch)
+            transfer.block = None
+            return self._advance_upload(transfer, data[0], data)
+        return self._after_step(transfer, step)
+
+    def _after_step(self, transfer: _Transfer, step: Step) -> bytes | None:
+        if step.data is not None:
+            self._send_last(transfer, step.reply)
+            self._finish(transfer, step.data)
+            return None
+        if step.block_done:
+            self._report(transfer, transfer.block.size if transfer.block is not None else None)
+        return _LISTEN if step.reply is None else step.reply
+
+    def _send_last(self, transfer: _Transfer, frame: bytes | None) -> None:
+        """The client's last frame of a transfer (no answer comes: a dead link changes nothing any more)."""
+        if frame is None:
+            return
+        with contextlib.suppress(LinkDownError):
+            self.link.send(SDO_REQUEST + transfer.node, frame)
+
+    def _report(self, transfer: _Transfer, total: int | None) -> None:
+        """Progress of a large upload after a block; the client may stop it here (aborted at once)."""
+        if transfer.stop is not None and transfer.stop():
+            self._abort(transfer, ABORT_STOPPED)
+            raise SdoStopped(transfer.node, transfer.index, transfer.sub, "upload stopped by the client")
+        if transfer.progress is not None:
+            self._reports.append((transfer.progress, transfer.received_bytes, total))
 
     def _advance_upload(self, transfer: _Transfer, command: int, data: bytes) -> bytes | None:
         if not transfer.segmented:
@@ -498,6 +627,8 @@ class SdoEngine:
             self._finish(transfer, bytes(transfer.received[:expected] if expected is not None else transfer.received))
             return None
         transfer.toggle ^= 1
+        if transfer.progress is not None and len(transfer.received) % (PROGRESS_SEGMENTS * SEGMENT_BYTES) == 0:
+            self._report(transfer, transfer.expected_size)
         return bytes([0x60 | transfer.toggle << 4]) + bytes(7)
 
     def _advance_download(self, transfer: _Transfer, command: int, data: bytes) -> bytes | None:
@@ -540,7 +671,16 @@ class SdoEngine:
         self._finished.append((transfer, outcome))
 
     def _hand_over(self) -> None:
-        """Complete finished transfers (lock not held)."""
+        """Report progress and complete finished transfers (lock not held)."""
+        while self._reports:
+            try:
+                progress, done, total = self._reports.popleft()
+            except IndexError:  # another thread took the last one
+                break
+            try:
+                progress(done, total)
+            except Exception:  # a failing report must not keep the transfers of the batch from completing
+                log.exception("progress report of an SDO upload failed")
         while self._finished:
             try:
                 transfer, outcome = self._finished.popleft()

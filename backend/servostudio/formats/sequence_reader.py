@@ -13,6 +13,7 @@ sequence's type only once the whole sequence is read, since parameter order does
 from __future__ import annotations
 
 import os
+from collections.abc import Collection
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -61,11 +62,19 @@ def _located(issue: SequenceIssue) -> str:
     return f"{issue.keyword}: {issue.reason}" if issue.keyword else issue.reason
 
 
-def parse_sequence_text(text: str, file: str = "<string>", *, max_sequences: int = MAX_SEQUENCES) -> SequenceTable:
-    """Parse SEQUENCE.TXT text; ``max_sequences`` is the drive's 0x3612 (sequence numbers 0..max−1)."""
+def parse_sequence_text(
+    text: str,
+    file: str = "<string>",
+    *,
+    max_sequences: int = MAX_SEQUENCES,
+    types: Collection[SequenceType] | None = None,
+) -> SequenceTable:
+    """Parse SEQUENCE.TXT text; ``max_sequences`` is the drive's 0x3612 (sequence numbers 0..max−1), ``types``
+    the sequence types it supports (0x360F; None: every type) — a sequence of another type is an error at its
+    ``SeqType`` line, as the drive raises error 44 for it."""
     if max_sequences < 1:
         raise ValueError(f"max_sequences must be at least 1, got {max_sequences}")
-    reader = _Reader(min(max_sequences, MAX_SEQUENCES))
+    reader = _Reader(min(max_sequences, MAX_SEQUENCES), tuple(SequenceType) if types is None else tuple(types))
     for number, raw in enumerate(split_lines(text), start=1):
         reader.feed(number, raw)
     table = reader.finish()
@@ -74,10 +83,12 @@ def parse_sequence_text(text: str, file: str = "<string>", *, max_sequences: int
     return table
 
 
-def read_sequence_file(path: str | os.PathLike[str], *, max_sequences: int = MAX_SEQUENCES) -> SequenceTable:
+def read_sequence_file(
+    path: str | os.PathLike[str], *, max_sequences: int = MAX_SEQUENCES, types: Collection[SequenceType] | None = None
+) -> SequenceTable:
     """Read and parse a SEQUENCE.TXT from disk (8-bit text)."""
     text = Path(path).read_text(encoding=FILE_ENCODING)
-    return parse_sequence_text(text, str(path), max_sequences=max_sequences)
+    return parse_sequence_text(text, str(path), max_sequences=max_sequences, types=types)
 
 
 @dataclass(frozen=True)
@@ -98,8 +109,9 @@ class _Block:
 
 
 class _Reader:
-    def __init__(self, max_sequences: int) -> None:
+    def __init__(self, max_sequences: int, types: tuple[SequenceType, ...]) -> None:
         self.max_sequences = max_sequences
+        self.types = types
         self.issues: dict[SequenceIssue, None] = {}  # an ordered set: a default may fail the same way twice
         self.defaults: list[_Assignment] = []
         self.blocks: list[_Block] = []
@@ -239,7 +251,17 @@ class _Reader:
             )
             return None
         value = self.parse(source, SEQ_TYPE)
-        return SequenceType(value) if isinstance(value, int) else None
+        if not isinstance(value, int):
+            return None
+        if SequenceType(value) not in self.types:
+            allowed = ", ".join(kind.name for kind in self.types) or "none"
+            self.report(
+                source.line,
+                source.key,
+                f"{SequenceType(value).name} sequences are not supported by the drive (0x360F): allowed {allowed}",
+            )
+            return None
+        return SequenceType(value)
 
     def report_misplaced(self, assignment: _Assignment, kind: SequenceType) -> None:
         if find_any_type(assignment.key) is None:

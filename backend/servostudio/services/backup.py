@@ -31,6 +31,7 @@ from typing import TypeVar
 from servostudio.drive.access import Drive, DriveAccessError
 from servostudio.drive.cia402 import State, decode_state
 from servostudio.drive.object_values import ObjectValue
+from servostudio.drive.profiles import DeviceProfile
 from servostudio.drive.sdo import SAFETY_WAIT, SdoAbortError, SdoError, TransferBatch, settle
 from servostudio.errors import CommunicationError, InvalidInput, RefusedForSafety, ServoStudioError
 from servostudio.formats.objectfile import ObjectEntry, ObjectFileError, parse_object_file, write_object_file
@@ -299,8 +300,13 @@ def restore_drive(
 
 
 def drive_file_kinds(drive: Drive) -> list[FileKind]:
-    kinds = [FileKind(name) for name in drive.profile.parameter_files]
-    if drive.profile.has_sequences and drive.profile.has("sequence_parameters"):
+    return profile_file_kinds(drive.profile)
+
+
+def profile_file_kinds(profile: DeviceProfile) -> list[FileKind]:
+    """The files a backup of this device holds (a client of the server knows the device, not the drive)."""
+    kinds = [FileKind(name) for name in profile.parameter_files]
+    if profile.has_sequences and profile.has("sequence_parameters"):
         kinds.append(FileKind.SEQUENCE)
     return kinds
 

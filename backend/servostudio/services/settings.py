@@ -47,6 +47,7 @@ class Settings:
     motors_dir: Path = field(default_factory=builtin_motors_dir)
     export_dir: Path | None = field(default_factory=default_export_dir)
     buses: tuple[str, ...] = ()  # bus specs opened at startup
+    shares: tuple[str, ...] = ()  # buses shared as socketcand endpoints at startup: "BUS=[HOST:]PORT" (``--share``)
     host: str = DEFAULT_HOST
     port: int = DEFAULT_PORT
     data_dir: Path = field(default_factory=default_data_dir)  # users.json: users, API tokens, password-less choice

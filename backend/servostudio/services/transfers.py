@@ -94,12 +94,13 @@ def start_restore(
     return jobs.start("restore", _per_drive(connection, chosen, restore_one))
 
 
-def download(drive: Drive, kind: FileKind) -> str:
-    """Back up one file of one drive now and return its text."""
+def download(drive: Drive, kind: FileKind) -> tuple[str, dict[str, object]]:
+    """Back up one file of one drive now: its text, and the backup's result (objects, skipped) without the server's
+    temporary path."""
     with tempfile.TemporaryDirectory() as folder:
         path = Path(folder) / kind.value
-        backup_file(drive, path, kind)
-        return path.read_text(encoding=FILE_ENCODING)
+        result = backup_file(drive, path, kind)
+        return path.read_text(encoding=FILE_ENCODING), {**result.as_dict(), "file": kind.value}
 
 
 def upload(drive: Drive, kind: FileKind, data: bytes, store: bool) -> RestoreResult:

@@ -127,6 +127,13 @@ describe("faults and warnings", () => {
       "Fault 7: Over-current  0x2310", "Warning 2: Temperature  0x4210",
     ]);
     expect(testid(element, "fault-item")!.textContent).toContain("Check the motor wiring");
+    shown.val = report({
+      fault: true,
+      faults: [{ code: 64, cia402_code: 0xffa2, name: "Procedure error", remedy: "" }],
+      causes: [{ object: "0x6410,11 Motor data.Torque constant", value: 0, problem: "is 0", needed_by: "auto-tuning" }],
+    } as Partial<FaultReport>);
+    expect(testid(element, "fault-cause")!.textContent).toBe(
+      "Likely cause: 0x6410,11 Motor data.Torque constant is 0auto-tuning needs it: set it, then start again.");
     shown.val = report({ fault: true, error_code: 0x5530, error_text: "EEPROM" });
     expect(testid(element, "fault-item")!.textContent).toBe("Fault: EEPROM  0x5530");
     shown.val = "no answer";

@@ -70,15 +70,18 @@ describe("parameter editor", () => {
     view.dispose();
   });
 
-  it("selects a clicked row and writes the typed value to the drive and the project", async () => {
+  it("selects a clicked row and writes the typed value to the drive and the project when chosen", async () => {
     const { view, element, sources } = editor({ q: "KIv" });
     await view.start();
     rowOf(element, "0x60F9.3")!.click();
     expect(rowOf(element, "0x60F9.3")!.classList.contains("selected")).toBe(true);
     await vi.waitFor(() => expect(find(element, "detail-drive-value")!.textContent).toBe("50"));
+    const both = find(element, "target-both") as HTMLInputElement;
+    both.checked = true;
+    both.dispatchEvent(new Event("change"));
     type(find(element, "param-editor") as HTMLInputElement, "77");
     find(element, "param-write")!.click();
-    await vi.waitFor(() => expect(element.querySelector("[data-status]")!.textContent).toBe("0x60F9.3 = 77 written to drive and project"));
+    await vi.waitFor(() => expect(element.querySelector("[data-status]")!.textContent).toBe("0x60F9.3 = 77 written to the drive and the project"));
     expect(sources.drive!.write).toHaveBeenCalledWith(kiv, 77);
     expect(sources.project!.write).toHaveBeenCalledWith([{ entry: kiv, raw: 77 }]);
     expect(find(element, "detail-drive-value")!.textContent).toBe("77");

@@ -70,24 +70,23 @@ describe("parameter rows", () => {
 });
 
 describe("write targets", () => {
-  beforeEach(() => localStorage.clear());
-
-  it("resolve to what is there, remember the choice, and fall back when nothing chosen is there", () => {
-    const store = new ParameterStore(true, null);
-    const targets = new WriteTargets(store, true, true);
-    expect(targets.resolve()).toEqual({ drive: true, project: true });
-    targets.save({ drive: false, project: true });
-    expect(new WriteTargets(store, true, true).resolve()).toEqual({ drive: false, project: true });
-    targets.save({ drive: true, project: false });
-    store.online.val = false;
-    expect(targets.resolve()).toEqual({ drive: false, project: true });
+  it("go to the project unless the user picks the drive, and to the one place an entry can go", () => {
+    const targets = new WriteTargets();
+    expect(targets.resolve(true, true)).toEqual({ drive: false, project: true });
+    expect(targets.resolve(true, false)).toEqual({ drive: true, project: false }); // not held by the project
+    targets.chosen.val = "drive";
+    expect(targets.resolve(true, true)).toEqual({ drive: true, project: false });
+    expect(targets.resolve(false, true)).toEqual({ drive: false, project: true }); // drive offline
+    targets.chosen.val = "both";
+    expect(targets.resolve(true, true)).toEqual({ drive: true, project: true });
+    expect(new WriteTargets().resolve(true, true)).toEqual({ drive: false, project: true }); // never remembered
   });
 });
 
 function detailContext(overrides: Partial<DetailContext> = {}) {
   const store = new ParameterStore(true, null);
   const context: DetailContext = {
-    store, targets: new WriteTargets(store, true, true), hasDrive: true, hasProject: true,
+    store, targets: new WriteTargets(), hasDrive: true, hasProject: true,
     selected: state<Entry | null>(null), shown: state<Entry[]>(all), entries: all,
     write: vi.fn(async () => ["drive", "project"]), leave: vi.fn(), ...overrides,
   };
@@ -95,6 +94,11 @@ function detailContext(overrides: Partial<DetailContext> = {}) {
 }
 
 const find = (root: HTMLElement, id: string) => root.querySelector<HTMLElement>(`[data-testid="${id}"]`);
+/** Choose a radio button as the user does (checked, then the change event). */
+function pick(radio: HTMLElement | null): void {
+  (radio as HTMLInputElement).checked = true;
+  radio!.dispatchEvent(new Event("change"));
+}
 
 describe("detail pane and value editor", () => {
   beforeEach(() => localStorage.clear());
@@ -125,14 +129,40 @@ describe("detail pane and value editor", () => {
     press(editor, "Enter");
     expect(find(element, "param-error")!.textContent).toBe('"2,5": use "." as decimal separator');
     expect(context.write).not.toHaveBeenCalled();
+    pick(find(element, "target-both"));
+    expect(find(element, "param-write")!.textContent).toBe("Write to drive and project");
+    expect(find(element, "editor-holds")!.textContent).toBe("The field holds the drive value.");
     type(editor, "3.25");
     find(element, "param-write")!.click();
-    expect(context.write).toHaveBeenCalledWith(rated, 3250);
+    expect(context.write).toHaveBeenCalledWith(rated, 3250, { drive: true, project: true });
     store.driveCell(rated.key).val = { raw: 3250 };
-    await vi.waitFor(() => expect(element.querySelector("[data-status]")!.textContent).toBe("0x6075 = 3.25 written to drive and project"));
+    await vi.waitFor(() => expect(element.querySelector("[data-status]")!.textContent).toBe("0x6075 = 3.25 written to the drive and the project"));
     expect(find(element, "param-error")).toBeNull();
     store.driveCell(rated.key).val = { raw: 4000 };
     expect(editor.value).toBe("4"); // follows the drive again after the write
+  });
+
+  it("writes to the project by default and then holds the project value, showing what the drive still holds", async () => {
+    const { context, store, element } = detailContext({ write: vi.fn(async () => ["project"]) });
+    store.setProjectRows([projectRow(rated, 2500)]);
+    store.driveCell(rated.key).val = { raw: 2000 };
+    context.selected.val = rated;
+    const editor = find(element, "param-editor") as HTMLInputElement;
+    expect(editor.value).toBe("2.5"); // the project's value, not the drive's 2
+    expect(find(element, "param-write")!.textContent).toBe("Write to project");
+    expect(find(element, "detail-project-label")!.textContent).toBe("Project ◂ field");
+    expect(find(element, "detail-drive-label")!.textContent).toBe("Drive");
+    type(editor, "3");
+    press(editor, "Enter");
+    expect(context.write).toHaveBeenCalledWith(rated, 3000, { drive: false, project: true });
+    store.setProjectRows([projectRow(rated, 3000)]);
+    await vi.waitFor(() => expect(find(element, "param-status")!.textContent).toBe("0x6075 = 3 written to the project; the drive still holds 2"));
+    expect(editor.value).toBe("3"); // the written value stays in the field
+    expect(find(element, "detail-drive-value")!.textContent).toBe("2 A  (raw 2000)");
+    expect(find(element, "detail-project-value")!.textContent).toBe("3 A (DRIVEPAR.TXT)");
+    pick(find(element, "target-drive"));
+    expect(editor.value).toBe("2"); // now it holds the drive's
+    expect(find(element, "param-write")!.className).toContain("danger");
   });
 
   it("shows the server's refusal and keeps the text", async () => {
@@ -152,10 +182,10 @@ describe("detail pane and value editor", () => {
     expect(element.textContent).toContain("Read-only (ro).");
     store.setProjectRows([projectRow(kpv, 300)]);
     context.selected.val = kpv;
-    expect((find(element, "target-drive") as HTMLInputElement).checked).toBe(true);
-    store.online.val = false;
-    expect((find(element, "target-drive") as HTMLInputElement).disabled).toBe(true);
     expect((find(element, "target-project") as HTMLInputElement).checked).toBe(true);
+    store.online.val = false;
+    expect(find(element, "target-drive")).toBeNull();
+    expect(element.textContent).toContain("Writes to the project.");
     expect(element.textContent).toContain("drive offline");
   });
 });

@@ -8,7 +8,7 @@ import type { Dictionary } from "../lib/od";
 
 const channel = (key: string, unit: string) => ({ key, name: key, unit, data_type: "INTEGER32", scale: 1, offset: 0 });
 const capture: CaptureData = {
-  id: "c1", name: null, definition: { channels: ["0x60FF,0", "0x606C,0"], period_us: 500, mode: "single", pre_trigger_pct: 25, auto_timeout_ms: 100 },
+  id: "c1", name: null, definition: { channels: ["0x60FF,0", "0x606C,0"], period_us: 500, mode: "single", pre_trigger_pct: 25, auto_timeout_ms: 100, source: "auto" },
   channels: [channel("0x60FF,0", "user unit/s"), channel("0x6041,0", "")],
   period_ns: 500_000, samples: 4, trigger_index: 1, trigger: "0x60FF,0 rising 100 user unit/s",
   values: [[0, 500, 500, 500], [1, 2, null, 4]],

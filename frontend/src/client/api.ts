@@ -86,6 +86,19 @@ export async function request<T>(
   fetchImpl: typeof fetch = fetch,
   signal?: AbortSignal,
 ): Promise<T> {
+  const response = await exchange(method, path, body, fetchImpl, signal);
+  if (response.status === 204) return undefined as T;
+  return (await response.json()) as T;
+}
+
+/** One call, answered with the response itself (to read a header such as `X-Scan-Hint`) once it succeeded. */
+export async function exchange(
+  method: string,
+  path: string,
+  body?: unknown,
+  fetchImpl: typeof fetch = fetch,
+  signal?: AbortSignal,
+): Promise<Response> {
   const init: RequestInit = { method, headers: { Accept: "application/json" }, signal };
   if (motionClient) (init.headers as Record<string, string>)["X-Servo-Client"] = motionClient;
   const csrf = SAFE_METHODS.has(method) ? null : csrfToken();
@@ -100,8 +113,7 @@ export async function request<T>(
   const response = await fetchImpl(path, init);
   if (response.status === 401) whenUnauthenticated();
   if (!response.ok) throw await errorOf(path, response);
-  if (response.status === 204) return undefined as T;
-  return (await response.json()) as T;
+  return response;
 }
 
 export function getJson<T>(path: string, fetchImpl: typeof fetch = fetch): Promise<T> {
@@ -163,6 +175,7 @@ export type Comparison = Schemas["CompareModel"];
 export type Motor = Schemas["MotorModel"];
 export type AxisChoice = Schemas["AxisChoiceModel"];
 export type Template = Schemas["TemplateModel"];
+export type KeptRevision = Schemas["KeptRevisionModel"];
 type ProjectChange = Schemas["ProjectUpdate"];
 type AxisChange = Schemas["AxisUpdate"];
 
@@ -196,8 +209,12 @@ export const projects = {
     del<Project>(`${axisPath(project, axis)}?revision=${e(revision)}`),
   parameters: (project: string, axis: string) =>
     get<ParameterList>(`${axisPath(project, axis)}/parameters?include_unsaved=true`),
-  setParameters: (project: string, axis: string, values: Record<string, number | string>, revision?: string) =>
-    put<ParameterList>(`${axisPath(project, axis)}/parameters`, { values, revision }),
+  setParameters: (project: string, axis: string, values: Record<string, number | string>, revision?: string, keepRevision = false) =>
+    put<ParameterList>(`${axisPath(project, axis)}/parameters`, { values, revision, keep_revision: keepRevision }),
+  /** The project as it was before each change that replaced many values, newest first. */
+  revisions: (name: string) => get<KeptRevision[]>(`/api/projects/${e(name)}/revisions`),
+  restoreRevision: (name: string, kept: string, revision?: string) =>
+    post<Project>(`/api/projects/${e(name)}/revisions/${e(kept)}/restore`, { revision }),
   resetParameters: (project: string, axis: string, addresses: string[], revision?: string) =>
     post<ParameterList>(`${axisPath(project, axis)}/parameters/reset`, { addresses, revision }),
   compare: (project: string, axis: string, onlyDifferences: boolean) =>
@@ -222,12 +239,13 @@ export async function setParametersSkipping(
   project: string,
   axis: string,
   values: Record<string, number | string>,
+  keepRevision = false,
 ): Promise<{ parameters: ProjectParameter[]; skipped: string[] }> {
   const remaining = { ...values };
   const skipped: string[] = [];
   for (;;) {
     try {
-      const answer = await projects.setParameters(project, axis, remaining);
+      const answer = await projects.setParameters(project, axis, remaining, undefined, keepRevision);
       return { parameters: answer.parameters, skipped };
     } catch (error) {
       const address = error instanceof ApiError && error.status === 422 ? /0x[0-9A-F]{4},\d+/i.exec(error.message)?.[0] : undefined;

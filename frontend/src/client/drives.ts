@@ -1,6 +1,6 @@
 /** The communication server's bus and drive routes (`/api/buses/…`): objects, state, faults, scan, NMT. */
 
-import { get, post, put, request, projectAddress } from "./api";
+import { exchange, get, post, put, request, projectAddress } from "./api";
 import type { Scalar } from "../lib/od";
 import { state, type State } from "../lib/dom";
 import type { Schemas } from "./schema-types";
@@ -9,6 +9,11 @@ const e = encodeURIComponent;
 
 // The payloads are the server's pydantic models (generated into schema.d.ts by `make api-types`).
 export type NodeIdentity = Schemas["NodeIdentity"];
+/** A scan's answer; `hint` (the `X-Scan-Hint` header) says why a bus may look empty, null when nodes were found. */
+export interface ScanResult {
+  nodes: NodeIdentity[];
+  hint: string | null;
+}
 export type BusInfo = Schemas["BusStatus"];
 export type ObjectValue = Schemas["ObjectValueModel"];
 export type ReadResult = Schemas["ReadResult"];
@@ -28,7 +33,8 @@ const MAX_BATCH = 256;
 
 /**
  * Project bus name → the server's bus id. A project names its bus ("sim") and gives its spec; the server may have
- * opened that spec under another id ("bus0"). `learnBuses` learns the mapping: same id first, else same spec. The
+ * opened that spec under another id ("bus0"). `learnBuses` learns the mapping from the server (`POST /api/buses/match`:
+ * same spec however spelt, else same name). The
  * mapping is a state, so a binding that shows `serverBus(…)` follows it.
  */
 const aliases: State<ReadonlyMap<string, string>> = state(new Map());
@@ -36,14 +42,28 @@ let learned: () => void = () => undefined;
 /** Resolves once the mapping was learned (after the app loaded projects and buses); drive calls wait for it. */
 const aliasesKnown = new Promise<void>((resolve) => (learned = resolve));
 
+export type BusMatch = Schemas["BusMatchModel"];
+/** The server's answer per project bus name: which open bus it is and by what (spec, name); the project page shows it. */
+export const busMatches: State<ReadonlyMap<string, BusMatch>> = state(new Map());
+let matchRequests = 0;
+
 export function learnBuses(server: BusInfo[], projectBuses: { name: string; interface: string }[]): void {
-  learned();
   const next = new Map<string, string>();
   for (const bus of projectBuses) {
     const match = server.find((candidate) => candidate.id === bus.name) ?? server.find((candidate) => candidate.spec === bus.interface);
     if (match) next.set(bus.name, match.id);
   }
   aliases.val = next;
+  const asked = ++matchRequests;
+  if (server.length === 0 || projectBuses.length === 0) return learned();
+  // The server compares specs as it parses them (`socketcand:h:p` is `socketcand:h:p/can0`): its answer decides.
+  void post<BusMatch[]>("/api/buses/match", { buses: projectBuses.map((bus) => ({ name: bus.name, spec: bus.interface })) })
+    .then((matches) => {
+      if (asked !== matchRequests) return; // a later call asked again: its answer counts
+      aliases.val = new Map(matches.flatMap((match) => (match.bus ? [[match.name, match.bus] as [string, string]] : [])));
+      busMatches.val = new Map(matches.map((match) => [match.name, match]));
+    }, () => undefined)
+    .finally(learned);
 }
 
 /** Names under which the UI knows a server bus: its id and every project bus mapped to it. */
@@ -68,7 +88,11 @@ export const driveApi = {
   bus: (bus: string) => get<BusInfo>(`/api/buses/${e(serverBus(bus))}`),
   openBus: (spec: string, id?: string) => post<BusInfo>("/api/buses", { spec, id: id || null }),
   closeBus: (bus: string) => aliasesKnown.then(() => request<void>("DELETE", `/api/buses/${e(serverBus(bus))}`)),
-  scan: (bus: string) => aliasesKnown.then(() => post<NodeIdentity[]>(`/api/buses/${e(serverBus(bus))}/scan`)),
+  /** The nodes found, and when there are none the server's reasons why the bus may look empty for its kind. */
+  scan: (bus: string) => aliasesKnown.then(async (): Promise<ScanResult> => {
+    const response = await exchange("POST", `/api/buses/${e(serverBus(bus))}/scan`, {});
+    return { nodes: (await response.json()) as NodeIdentity[], hint: response.headers.get("X-Scan-Hint") };
+  }),
   nmt: (bus: string, command: string, node = 0) =>
     aliasesKnown.then(() => post<void>(`/api/buses/${e(serverBus(bus))}/nmt`, { command, node })),
 

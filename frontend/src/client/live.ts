@@ -60,6 +60,7 @@ export class LiveHub {
   /** Whether the event socket is open: axis states and job ends then arrive as events, no polling needed. */
   readonly socketOpen: State<boolean> = state(false);
   private watched: AxisConfig[] = [];
+  private socket: WebSocket | null = null;
 
   start(): void {
     this.connect();
@@ -67,6 +68,13 @@ export class LiveHub {
 
   connected(): boolean {
     return this.socketOpen.rawVal;
+  }
+
+  /** Send a message on the event socket (the hold-to-run keepalive); false when it is not open. */
+  send(message: Record<string, unknown>): boolean {
+    if (this.socket?.readyState !== WebSocket.OPEN) return false;
+    this.socket.send(JSON.stringify(message));
+    return true;
   }
 
   /** Subscribe to one event type ("*" for all); returns the unsubscribe function. */
@@ -148,7 +156,7 @@ export class LiveHub {
 
   private connect(): void {
     const protocol = window.location.protocol === "https:" ? "wss:" : "ws:";
-    const socket = new WebSocket(`${protocol}//${window.location.host}/api/ws/events`);
+    const socket = (this.socket = new WebSocket(`${protocol}//${window.location.host}/api/ws/events`));
     socket.addEventListener("open", () => {
       this.socketOpen.val = true;
       void this.refreshAxes();

@@ -71,6 +71,8 @@ export interface EventMap {
   };
   /** Another client asks this page, the axis's controller, to release the axis. */
   control_request: NodeEvent & { type: "control_request"; to: string; from: { client: string; user: string } };
+  /** A quick-test motion of an axis started, ended or changed (services/motion/jog.py): as `GET …/motion` gives it. */
+  motion: { type: "motion" } & Schemas["MotionModel"];
   /** Not from the server: the event socket (re)opened. */
   ws_open: { type: "ws_open" };
 }

@@ -48,8 +48,25 @@ export interface paths {
         /** Open buses with their connection state and known nodes */
         get: operations["list_buses_api_buses_get"];
         put?: never;
-        /** Open a bus from a spec string (an existing bus with the same spec is returned) */
+        /** Open a bus from a spec string: 201 opened; 200 with existing: true when that spec is open already (without id or under the same id); 409 naming the open bus when another id is asked for */
         post: operations["open_bus_api_buses_post"];
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
+    "/api/buses/match": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        get?: never;
+        put?: never;
+        /** Which open bus each project bus is: by spec (any spelling) first, else by name */
+        post: operations["match_buses_api_buses_match_post"];
         delete?: never;
         options?: never;
         head?: never;
@@ -245,6 +262,109 @@ export interface paths {
         patch?: never;
         trace?: never;
     };
+    "/api/buses/{bus}/nodes/{node}/motion": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        /** The axis's running (else last) motion; null: none */
+        get: operations["current_api_buses__bus__nodes__node__motion_get"];
+        put?: never;
+        post?: never;
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
+    "/api/buses/{bus}/nodes/{node}/motion/home": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        get?: never;
+        put?: never;
+        /** Home the axis with a method */
+        post: operations["home_api_buses__bus__nodes__node__motion_home_post"];
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
+    "/api/buses/{bus}/nodes/{node}/motion/jog": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        get?: never;
+        put?: never;
+        /** Jog in profile velocity (the armed controller only, within the limits) */
+        post: operations["jog_api_buses__bus__nodes__node__motion_jog_post"];
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
+    "/api/buses/{bus}/nodes/{node}/motion/limits": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        /** The axis's quick-test limits */
+        get: operations["get_limits_api_buses__bus__nodes__node__motion_limits_get"];
+        /** Raise (or lower) the axis's quick-test limits until the server restarts */
+        put: operations["set_limits_api_buses__bus__nodes__node__motion_limits_put"];
+        post?: never;
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
+    "/api/buses/{bus}/nodes/{node}/motion/move": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        get?: never;
+        put?: never;
+        /** Move in profile position, relative or absolute */
+        post: operations["move_api_buses__bus__nodes__node__motion_move_post"];
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
+    "/api/buses/{bus}/nodes/{node}/motion/stop": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        get?: never;
+        put?: never;
+        /** Quick stop (anyone may stop an axis) */
+        post: operations["stop_api_buses__bus__nodes__node__motion_stop_post"];
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
     "/api/buses/{bus}/nodes/{node}/objects/{key}": {
         parameters: {
             query?: never;
@@ -260,6 +380,57 @@ export interface paths {
          */
         put: operations["write_object_api_buses__bus__nodes__node__objects__key__put"];
         post?: never;
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
+    "/api/buses/{bus}/nodes/{node}/procedures": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        /** The drive's procedures, their status and their preconditions read from the drive now */
+        get: operations["list_procedures_api_buses__bus__nodes__node__procedures_get"];
+        put?: never;
+        post?: never;
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
+    "/api/buses/{bus}/nodes/{node}/procedures/auto_tuning/undo": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        get?: never;
+        put?: never;
+        /** Write an auto-tuning result's `before` gains back (checked completely before any write) */
+        post: operations["undo_tuning_api_buses__bus__nodes__node__procedures_auto_tuning_undo_post"];
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
+    "/api/buses/{bus}/nodes/{node}/procedures/{name}": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        get?: never;
+        put?: never;
+        /** Start a procedure as a job (refusals before anything is written; cancel the job to abort it) */
+        post: operations["start_procedure_api_buses__bus__nodes__node__procedures__name__post"];
         delete?: never;
         options?: never;
         head?: never;
@@ -377,7 +548,7 @@ export interface paths {
         };
         get?: never;
         put?: never;
-        /** Check a capture definition against the drive without arming anything (422 says why not) */
+        /** Check a capture definition without arming anything: the plan, with the rate and bus load of a TPDO or polled capture (422 says why not) */
         post: operations["check_capture_api_buses__bus__nodes__node__scope_check_post"];
         delete?: never;
         options?: never;
@@ -436,6 +607,157 @@ export interface paths {
         patch?: never;
         trace?: never;
     };
+    "/api/buses/{bus}/nodes/{node}/sequences": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        /**
+         * Upload
+         * @description The sequence memory as SEQUENCE.TXT, its sequences and graph against the drive's 0x3612 and 0x360F.
+         */
+        get: operations["upload_api_buses__bus__nodes__node__sequences_get"];
+        /**
+         * Download
+         * @description Validate the whole file against the drive, write it (LOAD or MERGE), verify, store if asked.
+         */
+        put: operations["download_api_buses__bus__nodes__node__sequences_put"];
+        post?: never;
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
+    "/api/buses/{bus}/nodes/{node}/sequences/inputs": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        get?: never;
+        /**
+         * Inputs
+         * @description The conditional input 0x3601,3 and, on the simulator, the physical inputs IN1..IN5.
+         */
+        put: operations["inputs_api_buses__bus__nodes__node__sequences_inputs_put"];
+        post?: never;
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
+    "/api/buses/{bus}/nodes/{node}/sequences/monitor": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        /**
+         * Read Monitor
+         * @description The state now and the timeline from sample ``since`` on.
+         */
+        get: operations["read_monitor_api_buses__bus__nodes__node__sequences_monitor_get"];
+        put?: never;
+        /**
+         * Start Monitor
+         * @description Map TPDO 4 (0x3605, 0x3601,2, 0x3602,1, 0x3602,3, event-driven) and watch it; ``fresh`` empties the
+         *     timeline.
+         */
+        post: operations["start_monitor_api_buses__bus__nodes__node__sequences_monitor_post"];
+        /** Stop Monitor */
+        delete: operations["stop_monitor_api_buses__bus__nodes__node__sequences_monitor_delete"];
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
+    "/api/buses/{bus}/nodes/{node}/sequences/reload": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        get?: never;
+        put?: never;
+        /**
+         * Reload
+         * @description ``lseq`` / ``mseq``: the drive's SEQUENCE.TXT into its sequence memory.
+         */
+        post: operations["reload_api_buses__bus__nodes__node__sequences_reload_post"];
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
+    "/api/buses/{bus}/nodes/{node}/sequences/start": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        get?: never;
+        put?: never;
+        /**
+         * Start
+         * @description Sequence mode, enable, start ``sequence``: the caller's live client must be the axis's armed controller.
+         */
+        post: operations["start_api_buses__bus__nodes__node__sequences_start_post"];
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
+    "/api/buses/{bus}/nodes/{node}/sequences/stop": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        get?: never;
+        put?: never;
+        /**
+         * Stop
+         * @description Control word bit 5: the program brakes and ends (the armed controller's, as every control word of an
+         *     enabled axis).
+         */
+        post: operations["stop_api_buses__bus__nodes__node__sequences_stop_post"];
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
+    "/api/buses/{bus}/nodes/{node}/sequences/store": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        get?: never;
+        put?: never;
+        /**
+         * Store
+         * @description ``sseq``: the sequence memory into the drive's SEQUENCE.TXT.
+         */
+        post: operations["store_api_buses__bus__nodes__node__sequences_store_post"];
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
     "/api/buses/{bus}/nodes/{node}/state": {
         parameters: {
             query?: never;
@@ -443,7 +765,11 @@ export interface paths {
             path?: never;
             cookie?: never;
         };
-        /** CiA 402 state and NMT state */
+        /**
+         * CiA 402 state and NMT state
+         * @description The NMT state as the node's heartbeat or boot-up said it; without one, the status word just read over SDO
+         *     proves it pre-operational or operational (``nmt_source: sdo``).
+         */
         get: operations["get_state_api_buses__bus__nodes__node__state_get"];
         /**
          * Walk the CiA 402 state machine to a target state
@@ -489,6 +815,29 @@ export interface paths {
          */
         post: operations["scan_bus_api_buses__bus__scan_post"];
         delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
+    "/api/buses/{bus}/share": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        /** The bus's socketcand endpoint for the user's own CANopen scripts (404 when not shared) */
+        get: operations["get_share_api_buses__bus__share_get"];
+        /**
+         * Share the bus as a socketcand endpoint on a loopback address (python canopen / python-can beside the UI)
+         * @description SDO requests of the clients are answered by the server's SDO engine in turn (one SDO client per channel);
+         *     their writes pass the motion guard; NMT and SYNC go on the bus, other client frames are dropped.
+         */
+        put: operations["put_share_api_buses__bus__share_put"];
+        post?: never;
+        /** Stop sharing the bus (its clients are disconnected) */
+        delete: operations["delete_share_api_buses__bus__share_delete"];
         options?: never;
         head?: never;
         patch?: never;
@@ -575,6 +924,23 @@ export interface paths {
         };
         /** Get Health */
         get: operations["get_health_api_health_get"];
+        put?: never;
+        post?: never;
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
+    "/api/homing-methods/{device}": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        /** A device's homing methods with the manual's description of each */
+        get: operations["homing_methods_api_homing_methods__device__get"];
         put?: never;
         post?: never;
         delete?: never;
@@ -851,6 +1217,7 @@ export interface paths {
          * Compare Axis
          * @description Project / default columns; with ``drive=true`` drive / project / default, read from the axis's live drive
          *     (its bus is opened on the server if needed), and a row differs when the drive's value is not the project's.
+         *     Rows are what a user can write or restore; ``read_only=true`` adds the read-only entries apart (``read_only``).
          */
         get: operations["compare_axis_api_projects__name__axes__axis__compare_get"];
         put?: never;
@@ -944,6 +1311,27 @@ export interface paths {
         /** Get Parameter */
         get: operations["get_parameter_api_projects__name__axes__axis__parameters__address__get"];
         put?: never;
+        post?: never;
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
+    "/api/projects/{name}/axes/{axis}/sequences": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        /** Read Project */
+        get: operations["read_project_api_projects__name__axes__axis__sequences_get"];
+        /**
+         * Write Project
+         * @description Checked by the file reader first: a file with an error is refused whole (422) and nothing is written.
+         */
+        put: operations["write_project_api_projects__name__axes__axis__sequences_put"];
         post?: never;
         delete?: never;
         options?: never;
@@ -1047,6 +1435,46 @@ export interface paths {
         patch?: never;
         trace?: never;
     };
+    "/api/projects/{name}/revisions": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        /**
+         * List Revisions
+         * @description The kept revisions, newest first: the project as it was before each change that replaced many values.
+         */
+        get: operations["list_revisions_api_projects__name__revisions_get"];
+        put?: never;
+        post?: never;
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
+    "/api/projects/{name}/revisions/{revision}/restore": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        get?: never;
+        put?: never;
+        /**
+         * Restore Revision
+         * @description Make the project what it was at a kept revision; the state it replaces is kept in turn (so this undoes).
+         */
+        post: operations["restore_revision_api_projects__name__revisions__revision__restore_post"];
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
     "/api/projects/{name}/scan": {
         parameters: {
             query?: never;
@@ -1129,6 +1557,64 @@ export interface paths {
         };
         /** A saved capture as a standalone interactive HTML file */
         get: operations["saved_html_api_projects__project__axes__axis__captures__name__html_get"];
+        put?: never;
+        post?: never;
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
+    "/api/projects/{project}/axes/{axis}/procedures": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        /** The procedure results saved under the axis, newest first */
+        get: operations["list_saved_api_projects__project__axes__axis__procedures_get"];
+        put?: never;
+        post?: never;
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
+    "/api/sequences/check": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        get?: never;
+        put?: never;
+        /**
+         * Check
+         * @description The file reader's verdict (issues with line, keyword and allowed range) and, when valid, the sequences and
+         *     the chaining graph; nothing is written anywhere.
+         */
+        post: operations["check_api_sequences_check_post"];
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
+    "/api/sequences/keywords": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        /**
+         * Keywords
+         * @description Every type's keywords: 0x3611 sub, unit, allowed values, default (the editor's fields).
+         */
+        get: operations["keywords_api_sequences_keywords_get"];
         put?: never;
         post?: never;
         delete?: never;
@@ -1486,6 +1972,38 @@ export interface components {
              */
             props?: string | null;
         };
+        /** BusMatchModel */
+        BusMatchModel: {
+            /**
+             * Bus
+             * @description the open bus it is (null: not open)
+             */
+            bus: string | null;
+            /**
+             * By
+             * @description name: same name and spec; spec: its spec is open under another name; name_only: the open bus of that name has another spec
+             */
+            by: ("name" | "spec" | "name_only") | null;
+            /** Name */
+            name: string;
+            /** Spec */
+            spec: string;
+        };
+        /**
+         * BusMatchRequest
+         * @example {
+         *       "buses": [
+         *         {
+         *           "name": "line1",
+         *           "spec": "socketcand:127.0.0.1:29536"
+         *         }
+         *       ]
+         *     }
+         */
+        BusMatchRequest: {
+            /** Buses */
+            buses: components["schemas"]["ProjectBusRef"][];
+        };
         /** BusModel */
         BusModel: {
             /**
@@ -1553,6 +2071,11 @@ export interface components {
         };
         /** CaptureModel */
         CaptureModel: {
+            /**
+             * Alignment Ns
+             * @description TPDO and polled captures: the largest distance of a sample from its instant
+             */
+            alignment_ns?: number | null;
             /** Captured At */
             captured_at: string;
             /** Channels */
@@ -1645,11 +2168,27 @@ export interface components {
              */
             samples?: number | null;
             /**
+             * Source
+             * @description the drive's recorder, synchronous TPDOs at the server's SYNC, or SDO polling
+             * @default auto
+             * @enum {string}
+             */
+            source: "auto" | "recorder" | "tpdo" | "poll";
+            /**
              * Timeout S
              * @description give up when no recording completes by then
              */
             timeout_s?: number | null;
             trigger?: components["schemas"]["TriggerModel"];
+        };
+        /** CatalogModel */
+        CatalogModel: {
+            /** Keywords */
+            keywords: {
+                [key: string]: components["schemas"]["KeywordModel"][];
+            };
+            /** Types */
+            types: string[];
         };
         /** ChannelModel */
         ChannelModel: {
@@ -1668,6 +2207,18 @@ export interface components {
             scale: number;
             /** Unit */
             unit: string;
+        };
+        /** CheckModel */
+        CheckModel: {
+            /** File */
+            file: string;
+            graph?: components["schemas"]["GraphModel"] | null;
+            /** Issues */
+            issues: components["schemas"]["IssueModel"][];
+            /** Ok */
+            ok: boolean;
+            /** Sequences */
+            sequences?: components["schemas"]["SequenceModel"][];
         };
         /** CommissionRequest */
         CommissionRequest: {
@@ -1690,6 +2241,12 @@ export interface components {
         CompareModel: {
             /** Columns */
             columns: string[];
+            /**
+             * Read Only
+             * @description with ?read_only=true: the read-only entries (error register, status word, measurements), apart from rows and never counted as differences: nobody writes or restores them
+             * @default []
+             */
+            read_only: components["schemas"]["CompareRowModel"][];
             /**
              * Refused
              * @description objects the drive refused to read: address -> reason
@@ -1724,6 +2281,13 @@ export interface components {
             values: {
                 [key: string]: number | string | null;
             };
+        };
+        /** CounterModel */
+        CounterModel: {
+            /** Remaining */
+            remaining: number;
+            /** Sequence */
+            sequence: number;
         };
         /** DictionaryModel */
         DictionaryModel: {
@@ -1775,6 +2339,52 @@ export interface components {
             /** Vendor Id */
             vendor_id: number;
         };
+        /** DownloadModel */
+        DownloadModel: {
+            /** Mismatched */
+            mismatched: number[];
+            /** Mode */
+            mode: string;
+            /** Node */
+            node: number;
+            /** Seconds */
+            seconds: number;
+            /** Sequences */
+            sequences: number[];
+            /** Stored */
+            stored: boolean;
+            /** Verified */
+            verified: boolean;
+        };
+        /** DownloadRequest */
+        DownloadRequest: {
+            /**
+             * File
+             * @description the name messages give the file
+             * @default SEQUENCE.TXT
+             */
+            file: string;
+            /**
+             * Mode
+             * @description load: slots the file does not declare are cleared
+             * @default load
+             * @enum {string}
+             */
+            mode: "load" | "merge";
+            /**
+             * Store
+             * @description store the verified memory to flash (sseq)
+             * @default false
+             */
+            store: boolean;
+            /**
+             * Text
+             * @description SEQUENCE.TXT (Latin-1 text)
+             * @example SeqNb=1
+             *     SeqType=POS
+             */
+            text: string;
+        };
         /** DriveIdentityModel */
         DriveIdentityModel: {
             /** Bus */
@@ -1796,6 +2406,33 @@ export interface components {
             /** Vendor Id */
             vendor_id: number | null;
         };
+        /** DriveSequencesModel */
+        DriveSequencesModel: {
+            /**
+             * Count
+             * @description 0x3612: sequence numbers 0..count-1
+             */
+            count: number;
+            /** File */
+            file: string;
+            graph?: components["schemas"]["GraphModel"] | null;
+            /** Issues */
+            issues: components["schemas"]["IssueModel"][];
+            /** Ok */
+            ok: boolean;
+            /** Sequences */
+            sequences?: components["schemas"]["SequenceModel"][];
+            /**
+             * Text
+             * @description the sequence memory as SEQUENCE.TXT
+             */
+            text: string;
+            /**
+             * Types
+             * @description 0x360F: the types the drive supports
+             */
+            types: string[];
+        };
         /**
          * DriveState
          * @example {
@@ -1806,8 +2443,22 @@ export interface components {
          *     }
          */
         DriveState: {
-            /** Nmt State */
+            /**
+             * Nmt Source
+             * @description heartbeat: nmt_state is the node's own; sdo: only known to answer SDO (pre-op or op)
+             */
+            nmt_source?: ("heartbeat" | "sdo") | null;
+            /**
+             * Nmt State
+             * @description as the node's heartbeat or boot-up said it (null: none seen)
+             */
             nmt_state?: string | null;
+            /**
+             * Nmt Text
+             * @description what is known, for display (e.g. 'PRE-OPERATIONAL or OPERATIONAL')
+             * @default
+             */
+            nmt_text: string;
             /** Node */
             node: number;
             /** State */
@@ -1849,6 +2500,20 @@ export interface components {
             ok: boolean;
             /** Stored */
             stored: boolean;
+        };
+        /** EdgeModel */
+        EdgeModel: {
+            /** Dangling */
+            dangling: boolean;
+            /** From */
+            from: number;
+            /**
+             * Kind
+             * @enum {string}
+             */
+            kind: "next" | "link" | "counter" | "condition";
+            /** To */
+            to: number;
         };
         /**
          * EntryModel
@@ -2033,6 +2698,42 @@ export interface components {
             /** Warnings */
             warnings: components["schemas"]["FaultInfoModel"][];
         };
+        /** FindingModel */
+        FindingModel: {
+            /**
+             * Kind
+             * @enum {string}
+             */
+            kind: "loop_without_exit" | "dangling" | "unreachable" | "counters" | "unsupported_type";
+            /** Message */
+            message: string;
+            /** Sequences */
+            sequences: number[];
+        };
+        /** GraphModel */
+        GraphModel: {
+            /** Edges */
+            edges: components["schemas"]["EdgeModel"][];
+            /** Findings */
+            findings: components["schemas"]["FindingModel"][];
+            /** Nodes */
+            nodes: components["schemas"]["GraphNodeModel"][];
+        };
+        /** GraphNodeModel */
+        GraphNodeModel: {
+            /** Entry */
+            entry: boolean;
+            /** Reachable */
+            reachable: boolean;
+            /** Sequence */
+            sequence: number;
+            /** Supported */
+            supported: boolean;
+            /** Type */
+            type: string;
+            /** Waits */
+            waits: boolean;
+        };
         /** Health */
         Health: {
             /** Status */
@@ -2057,6 +2758,80 @@ export interface components {
              * @example local
              */
             user: string;
+        };
+        /** HomeBody */
+        HomeBody: {
+            /**
+             * Hold
+             * @description hold-to-run: quick stop when the client's keepalive stops arriving
+             * @default false
+             */
+            hold: boolean;
+            /**
+             * Method
+             * @description homing method (0x6098), see GET /api/homing-methods/{device}
+             * @example 35
+             */
+            method: number;
+            /**
+             * Velocity
+             * @description rpm of the switch search; null: the drive's 0x6099
+             */
+            velocity?: number | null;
+        };
+        /** HomingMethodModel */
+        HomingMethodModel: {
+            /**
+             * Description
+             * @description the manual's description
+             */
+            description: string;
+            /**
+             * Method
+             * @example 35
+             */
+            method: number;
+        };
+        /** InputsModel */
+        InputsModel: {
+            /**
+             * Conditional
+             * @description 0x3601,3 now (bits 0-15)
+             */
+            conditional: number;
+            /**
+             * Sim
+             * @description what was written to the simulated inputs
+             */
+            sim?: number | null;
+        };
+        /** InputsRequest */
+        InputsRequest: {
+            /**
+             * Conditional
+             * @description 0x3601,3: a number or a pattern MSB first ("1......."; . keeps a bit)
+             */
+            conditional?: string | null;
+            /**
+             * Sim
+             * @description simulated drive only: IN5..IN1 (0x5F00), e.g. 10000
+             */
+            sim?: string | null;
+        };
+        /** IssueModel */
+        IssueModel: {
+            /** File */
+            file: string;
+            /** Keyword */
+            keyword: string | null;
+            /** Line */
+            line: number;
+            /**
+             * Reason
+             * @description why, with the allowed range
+             * @example value 200000 is out of range: allowed 1..65535
+             */
+            reason: string;
         };
         /**
          * JobModel
@@ -2083,12 +2858,98 @@ export interface components {
             /** State */
             state: string;
         };
+        /** JogBody */
+        JogBody: {
+            /**
+             * Hold
+             * @description hold-to-run: quick stop when the client's keepalive stops arriving
+             * @default false
+             */
+            hold: boolean;
+            /**
+             * Seconds
+             * @description how long; null: for as long as the hold lasts
+             */
+            seconds?: number | null;
+            /**
+             * Velocity
+             * @description rpm; the sign is the direction
+             * @example 60
+             */
+            velocity: number;
+        };
+        /** KeptRevisionModel */
+        KeptRevisionModel: {
+            /** Files */
+            files: number;
+            /**
+             * Reason
+             * @description what replaced it
+             */
+            reason: string;
+            /**
+             * Revision
+             * @description the project's revision before the change that replaced it
+             */
+            revision: string;
+            /**
+             * Saved At
+             * @description when it was replaced (epoch seconds)
+             */
+            saved_at: number;
+        };
+        /** KeywordModel */
+        KeywordModel: {
+            /** Aliases */
+            aliases: string[];
+            /** Allowed */
+            allowed: number[][] | null;
+            /** Constants */
+            constants: string[] | null;
+            /** Default */
+            default: string | number | null;
+            /** Name */
+            name: string;
+            /** Pattern */
+            pattern: boolean;
+            /** Subs */
+            subs: number[];
+            /** Unit */
+            unit: string;
+        };
         /**
          * Level
          * @description A user level; members are listed from the lowest to the highest.
          * @enum {string}
          */
         Level: "operator" | "maintenance" | "expert" | "administrator";
+        /** LimitsBody */
+        LimitsBody: {
+            /** Distance Revolutions */
+            distance_revolutions?: number | null;
+            /** Seconds */
+            seconds?: number | null;
+            /** Velocity Rpm */
+            velocity_rpm?: number | null;
+        };
+        /** LimitsModel */
+        LimitsModel: {
+            /**
+             * Distance Revolutions
+             * @description longest move
+             */
+            distance_revolutions: number;
+            /**
+             * Seconds
+             * @description longest timed jog
+             */
+            seconds: number;
+            /**
+             * Velocity Rpm
+             * @description fastest jog, move or homing speed
+             */
+            velocity_rpm: number;
+        };
         /** Login */
         Login: {
             /**
@@ -2098,6 +2959,114 @@ export interface components {
             name: string;
             /** Password */
             password: string;
+        };
+        /** MonitorModel */
+        MonitorModel: {
+            /**
+             * Captured Position
+             * @description 0x360B
+             */
+            captured_position: number | null;
+            /** @description the loop counter, counted by the monitor (no drive object) */
+            counter: components["schemas"]["CounterModel"] | null;
+            /**
+             * Dedicated Outputs
+             * @description 0x3602,3: POS, SEQ, SPEED, READY
+             */
+            dedicated_outputs: number;
+            /**
+             * Executed
+             * @description one per executed sequence: when it began, its last phase
+             */
+            executed: components["schemas"]["SampleModel"][];
+            /**
+             * Next
+             * @description pass as `since` to get only newer samples
+             */
+            next: number;
+            /**
+             * Now
+             * @description seconds since the monitor started, on the clock of `t`
+             */
+            now: number;
+            /**
+             * Outputs
+             * @description 0x3602,1
+             */
+            outputs: number;
+            /** Phase */
+            phase: string;
+            /**
+             * Phases
+             * @description 0x3605
+             */
+            phases: number;
+            /** Running */
+            running: boolean;
+            /** Sequence */
+            sequence: number;
+            /**
+             * Timeline
+             * @description samples from index `since` on
+             */
+            timeline: components["schemas"]["SampleModel"][];
+        };
+        /** MotionModel */
+        MotionModel: {
+            /** Bus */
+            bus: string;
+            /**
+             * Client
+             * @description the controller's client that started it
+             */
+            client?: string | null;
+            /**
+             * Ended
+             * @description Unix time
+             */
+            ended?: number | null;
+            /** Hold */
+            hold?: boolean | null;
+            /** Kind */
+            kind?: ("jog" | "move" | "home") | null;
+            /**
+             * Last Keepalive
+             * @description Unix time the last keepalive arrived
+             */
+            last_keepalive?: number | null;
+            /**
+             * Motion
+             * @description the motion's id; null: a stop with no motion running
+             */
+            motion: string | null;
+            /** Node */
+            node: number;
+            /**
+             * Position
+             * @description 0x6064 when it ended
+             */
+            position?: number | null;
+            /**
+             * Reason
+             * @description why it stopped or failed
+             */
+            reason: string | null;
+            /** Request */
+            request?: {
+                [key: string]: number | boolean | null;
+            } | null;
+            /**
+             * Started
+             * @description Unix time
+             */
+            started?: number | null;
+            /**
+             * State
+             * @enum {string}
+             */
+            state: "running" | "done" | "stopped" | "failed";
+            /** Statusword */
+            statusword?: number | null;
         };
         /** MotorChoice */
         MotorChoice: {
@@ -2146,6 +3115,31 @@ export interface components {
              * @default
              */
             source: string;
+        };
+        /** MoveBody */
+        MoveBody: {
+            /**
+             * Absolute
+             * @default false
+             */
+            absolute: boolean;
+            /**
+             * Distance
+             * @description user position units: relative, or the target with absolute
+             * @example 4096
+             */
+            distance: number;
+            /**
+             * Hold
+             * @description hold-to-run: quick stop when the client's keepalive stops arriving
+             * @default false
+             */
+            hold: boolean;
+            /**
+             * Velocity
+             * @description rpm; null: 60 rpm (capped by the limit)
+             */
+            velocity?: number | null;
         };
         /** NewName */
         NewName: {
@@ -2331,6 +3325,38 @@ export interface components {
              */
             value: number | string;
         };
+        /**
+         * OpenedBus
+         * @example {
+         *       "connected": true,
+         *       "id": "sim",
+         *       "kind": "sim",
+         *       "nodes": [],
+         *       "spec": "sim"
+         *     }
+         */
+        OpenedBus: {
+            /** Connected */
+            connected: boolean;
+            /** Error */
+            error?: string | null;
+            /**
+             * Existing
+             * @description the spec was open already (answered 200, under its own name)
+             */
+            existing: boolean;
+            /** Id */
+            id: string;
+            /** Kind */
+            kind: string;
+            /**
+             * Nodes
+             * @default []
+             */
+            nodes: components["schemas"]["NodeIdentity"][];
+            /** Spec */
+            spec: string;
+        };
         /** ParameterList */
         ParameterList: {
             /** Parameters */
@@ -2387,6 +3413,12 @@ export interface components {
         };
         /** ParameterWrite */
         ParameterWrite: {
+            /**
+             * Keep Revision
+             * @description keep the project as it was before this change restorable (GET/POST …/revisions): for a change that replaces many values, such as a backup of the drive into the project
+             * @default false
+             */
+            keep_revision: boolean;
             /** Revision */
             revision?: string | null;
             /**
@@ -2412,23 +3444,60 @@ export interface components {
         };
         /**
          * PlanModel
-         * @description A definition the drive accepts, as the recorder will run it.
+         * @description A definition the drive accepts, as the recorder (or the TPDOs, or polling) will run it.
          */
         PlanModel: {
-            /** Bytes */
-            bytes: number;
+            /**
+             * Bytes
+             * @description recorder: bytes of the recording
+             */
+            bytes?: number | null;
             /** Channels */
             channels: components["schemas"]["ChannelModel"][];
-            /** Multiplier */
-            multiplier: number;
+            /**
+             * Multiplier
+             * @description recorder: periods of the base period per sample
+             */
+            multiplier?: number | null;
             /** Period Ns */
             period_ns: number;
             /** Pre Trigger */
             pre_trigger: number;
-            /** Record Size */
-            record_size: number;
+            /**
+             * Record Size
+             * @description recorder: bytes per record
+             */
+            record_size?: number | null;
             /** Samples */
             samples: number;
+            /**
+             * Source
+             * @enum {string}
+             */
+            source: "recorder" | "tpdo" | "poll";
+            /** @description TPDO and polled captures: rate, bus load, alignment */
+            stream?: components["schemas"]["StreamPlanModel"] | null;
+        };
+        /** PreconditionModel */
+        PreconditionModel: {
+            /**
+             * Label
+             * @example Drive disabled
+             */
+            label: string;
+            /**
+             * Name
+             * @description the check, or value:<object> for a value it needs
+             * @example disabled
+             */
+            name: string;
+            /** Ok */
+            ok: boolean;
+            /**
+             * Reason
+             * @description why not, in the manual's words; null when ok
+             */
+            reason?: string | null;
         };
         /** PresetModel */
         PresetModel: {
@@ -2439,6 +3508,82 @@ export interface components {
             key: string;
             /** Title */
             title: string;
+        };
+        /** ProcedureModel */
+        ProcedureModel: {
+            /**
+             * Label
+             * @example Auto-tuning
+             */
+            label: string;
+            /**
+             * Moves
+             * @description turns the motor: needs the axis's armed controller (X-Servo-Client)
+             */
+            moves: boolean;
+            /**
+             * Name
+             * @example auto_tuning
+             */
+            name: string;
+            /** Preconditions */
+            preconditions: components["schemas"]["PreconditionModel"][];
+            /**
+             * Ready
+             * @description every precondition is met
+             */
+            ready: boolean;
+            /**
+             * Status
+             * @description the trigger's read-back status now
+             * @enum {string}
+             */
+            status: "never" | "cannot" | "running" | "aborted" | "error" | "done" | "unknown";
+        };
+        /**
+         * ProcedureStart
+         * @description Start a procedure; options per procedure (auto_tuning: bandwidth 50|75|100, filter standard|anti-resonance|
+         *     max-stiffness, speed_filter auto|0.5|1|2, mode min-following-error|min-overshoot; current_loop: inductance_mh
+         *     (phase to phase, written to the motor data first), regulator high|low).
+         * @example {
+         *       "options": {
+         *         "bandwidth": 75,
+         *         "filter": "standard"
+         *       },
+         *       "verify": true
+         *     }
+         */
+        ProcedureStart: {
+            /** Axis */
+            axis?: string | null;
+            /** Options */
+            options?: {
+                [key: string]: string | number | null;
+            };
+            /**
+             * Project
+             * @description save the result under this project's axis
+             */
+            project?: string | null;
+            /**
+             * Verify
+             * @description run the verification (auto-phasing: commutation; auto-tuning: steps)
+             * @default true
+             */
+            verify: boolean;
+        };
+        /** ProjectBusRef */
+        ProjectBusRef: {
+            /**
+             * Name
+             * @description the project's name of the bus
+             */
+            name: string;
+            /**
+             * Spec
+             * @description the project's spec of the bus (its interface)
+             */
+            spec: string;
         };
         /** ProjectCreate */
         ProjectCreate: {
@@ -2470,6 +3615,34 @@ export interface components {
              * @description pass back with the next change (optimistic concurrency)
              */
             revision: string;
+        };
+        /** ProjectSequences */
+        ProjectSequences: {
+            /** Revision */
+            revision: string;
+            /** Text */
+            text: string;
+        };
+        /** ProjectSequencesWrite */
+        ProjectSequencesWrite: {
+            /**
+             * File
+             * @description the name messages give the file
+             * @default SEQUENCE.TXT
+             */
+            file: string;
+            /**
+             * Revision
+             * @description the revision read; a changed project is refused (409)
+             */
+            revision?: string | null;
+            /**
+             * Text
+             * @description SEQUENCE.TXT (Latin-1 text)
+             * @example SeqNb=1
+             *     SeqType=POS
+             */
+            text: string;
         };
         /** ProjectSummary */
         ProjectSummary: {
@@ -2536,6 +3709,15 @@ export interface components {
              */
             status: string;
         };
+        /** ReloadRequest */
+        ReloadRequest: {
+            /**
+             * Mode
+             * @default load
+             * @enum {string}
+             */
+            mode: "load" | "merge";
+        };
         /**
          * RestoreRequest
          * @example {
@@ -2571,6 +3753,55 @@ export interface components {
              * @default true
              */
             store: boolean;
+        };
+        /** RevisionRestore */
+        RevisionRestore: {
+            /**
+             * Revision
+             * @description the project's current revision (refused if it changed)
+             */
+            revision?: string | null;
+        };
+        /** RunModel */
+        RunModel: {
+            /** Node */
+            node: number;
+            /** Sequence */
+            sequence?: number | null;
+            /**
+             * Started
+             * @default false
+             */
+            started: boolean;
+            /** State */
+            state?: string | null;
+            /**
+             * Stopped
+             * @default false
+             */
+            stopped: boolean;
+        };
+        /** SampleModel */
+        SampleModel: {
+            /**
+             * Phase
+             * @example BEGIN
+             * @example CRUISE
+             * @example DECEL
+             * @example HOLD
+             * @example INPOS
+             * @example END
+             * @example WAIT
+             * @example IDLE
+             */
+            phase: string;
+            /** Sequence */
+            sequence: number;
+            /**
+             * T
+             * @description seconds since the monitor started (the drive's clock between TPDOs)
+             */
+            t: number;
         };
         /** SaveRequest */
         SaveRequest: {
@@ -2662,22 +3893,64 @@ export interface components {
         };
         /**
          * ScopeInfo
-         * @description The drive's recorder: its limits, its status and the presets this drive can run.
+         * @description The drive's recorder (or, without one, the TPDO capture's limits): its status and the presets it can run.
          */
         ScopeInfo: {
-            /** Base Period Ns */
+            /**
+             * Base Period Ns
+             * @description the shortest period: the control period, or the server's 1 ms SYNC
+             */
             base_period_ns: number;
             /**
              * Capacity
-             * @description bytes of one recording
+             * @description bytes of one recording (none without a recorder)
              */
-            capacity: number;
+            capacity: number | null;
             /** Channels */
             channels: number;
             /** Presets */
             presets: components["schemas"]["PresetModel"][];
+            /**
+             * Source
+             * @description how this drive's captures are taken
+             * @enum {string}
+             */
+            source: "recorder" | "tpdo" | "poll";
             /** Status */
             status: string;
+        };
+        /** SequenceModel */
+        SequenceModel: {
+            /** Sequence */
+            sequence: number;
+            /**
+             * Type
+             * @example POS
+             */
+            type: string;
+            /**
+             * Values
+             * @description every parameter in the file's spelling: numbers, constants by name, patterns of 8 characters; null: a default the file cannot spell
+             */
+            values: {
+                [key: string]: string | number | null;
+            };
+        };
+        /** SequenceText */
+        SequenceText: {
+            /**
+             * File
+             * @description the name messages give the file
+             * @default SEQUENCE.TXT
+             */
+            file: string;
+            /**
+             * Text
+             * @description SEQUENCE.TXT (Latin-1 text)
+             * @example SeqNb=1
+             *     SeqType=POS
+             */
+            text: string;
         };
         /** SettingModel */
         SettingModel: {
@@ -2728,6 +4001,66 @@ export interface components {
             passwordless: boolean;
         };
         /**
+         * ShareModel
+         * @example {
+         *       "bus": "sim",
+         *       "channel": "can0",
+         *       "clients": 1,
+         *       "dropped": 0,
+         *       "host": "127.0.0.1",
+         *       "port": 29540
+         *     }
+         */
+        ShareModel: {
+            /** Bus */
+            bus: string;
+            /**
+             * Channel
+             * @description the socketcand channel a client opens
+             */
+            channel: string;
+            /**
+             * Clients
+             * @description clients connected now
+             */
+            clients: number;
+            /**
+             * Dropped
+             * @description client frames not put on the bus (PDOs and others; SDO and NMT pass)
+             */
+            dropped: number;
+            /** Host */
+            host: string;
+            /** Port */
+            port: number;
+        };
+        /**
+         * ShareRequest
+         * @example {
+         *       "host": "127.0.0.1",
+         *       "port": 29540
+         *     }
+         */
+        ShareRequest: {
+            /**
+             * Host
+             * @description a loopback address (127.0.0.1, ::1, localhost)
+             * @default 127.0.0.1
+             */
+            host: string;
+            /**
+             * Port
+             * @description TCP port; 0: any free port (the answer names it)
+             * @default 0
+             */
+            port: number;
+        };
+        /** StartRequest */
+        StartRequest: {
+            /** Sequence */
+            sequence: number;
+        };
+        /**
          * StateRequest
          * @example {
          *       "target": "operation-enabled"
@@ -2739,6 +4072,42 @@ export interface components {
              * @description switch-on-disabled | ready-to-switch-on | switched-on | operation-enabled | quick-stop-active
              */
             target: string;
+        };
+        /**
+         * StreamPlanModel
+         * @description A capture without the recorder: the rate and the bus load it will make, stated before arming.
+         */
+        StreamPlanModel: {
+            /**
+             * Alignment
+             * @description how the channels and axes line up in time
+             */
+            alignment: string;
+            /** Bitrate */
+            bitrate: number;
+            /**
+             * Bitrate Assumed
+             * @description the bus spec does not give the bit rate: 1 Mbit/s assumed
+             */
+            bitrate_assumed: boolean;
+            /**
+             * Bus Load
+             * @description share of the bus (worst-case stuff bits), 0..1
+             */
+            bus_load: number;
+            /** Frames Per S */
+            frames_per_s: number;
+            /**
+             * Min Period Ns
+             * @description the shortest period this capture could have
+             */
+            min_period_ns: number;
+            /** Nodes */
+            nodes: number[];
+            /** Rate Hz */
+            rate_hz: number;
+            /** Tpdos */
+            tpdos: components["schemas"]["TpdoUseModel"][];
         };
         /** TakeRequest */
         TakeRequest: {
@@ -2817,6 +4186,18 @@ export interface components {
             /** @description at most the caller's own level */
             level: components["schemas"]["Level"];
         };
+        /** TpdoUseModel */
+        TpdoUseModel: {
+            /** Channels */
+            channels: number;
+            /** Node */
+            node: number;
+            /**
+             * Tpdo
+             * @description the TPDO's number, 1-based
+             */
+            tpdo: number;
+        };
         /** TriggerModel */
         TriggerModel: {
             /**
@@ -2836,6 +4217,26 @@ export interface components {
              * @description object or channel that triggers; none: immediate
              */
             source?: string | null;
+        };
+        /** UndoRequest */
+        UndoRequest: {
+            /**
+             * Gains
+             * @description the `before` of an auto-tuning result: semantic name → raw value
+             */
+            gains: {
+                [key: string]: number;
+            };
+        };
+        /** UndoResult */
+        UndoResult: {
+            /**
+             * Gains
+             * @description the gains as read back after the write
+             */
+            gains: {
+                [key: string]: unknown;
+            };
         };
         /** UserChange */
         UserChange: {
@@ -3058,13 +4459,91 @@ export interface operations {
             };
         };
         responses: {
+            /** @description the spec was open already: that bus, existing: true */
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["OpenedBus"];
+                };
+            };
             /** @description Successful Response */
             201: {
                 headers: {
                     [name: string]: unknown;
                 };
                 content: {
-                    "application/json": components["schemas"]["BusStatus"];
+                    "application/json": components["schemas"]["OpenedBus"];
+                };
+            };
+            /** @description `not_found`: unknown bus, node, job, object, device, project, axis or motor */
+            404: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `conflict`: the current state refuses it: a changed project, a taken name, the drive */
+            409: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `invalid_input`: refused before anything was sent or written */
+            422: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `internal`: a bug: logged with the request id */
+            500: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `unavailable`: the bus is not connected, or an axis's drive cannot be reached */
+            503: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+        };
+    };
+    match_buses_api_buses_match_post: {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        requestBody: {
+            content: {
+                "application/json": components["schemas"]["BusMatchRequest"];
+            };
+        };
+        responses: {
+            /** @description Successful Response */
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["BusMatchModel"][];
                 };
             };
             /** @description `not_found`: unknown bus, node, job, object, device, project, axis or motor */
@@ -3936,6 +5415,8 @@ export interface operations {
             /** @description Successful Response */
             200: {
                 headers: {
+                    /** @description the backup's result as JSON: {node, file, kind, objects, skipped: [{object, reason}], seconds} */
+                    "X-Backup-Result"?: string;
                     [name: string]: unknown;
                 };
                 content: {
@@ -4131,6 +5612,660 @@ export interface operations {
             };
         };
     };
+    current_api_buses__bus__nodes__node__motion_get: {
+        parameters: {
+            query?: never;
+            header?: {
+                /** @description id announced by /api/ws/events; required for motion */
+                "X-Servo-Client"?: string | null;
+            };
+            path: {
+                /** @description node ID */
+                node: number;
+                bus: string;
+            };
+            cookie?: never;
+        };
+        requestBody?: never;
+        responses: {
+            /** @description Successful Response */
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["MotionModel"] | null;
+                };
+            };
+            /** @description `not_found`: unknown bus, node, job, object, device, project, axis or motor */
+            404: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `conflict`: the current state refuses it: a changed project, a taken name, the drive; `refused_for_safety`: refused to keep the machine safe (no live client, drive enabled) */
+            409: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `invalid_input`: refused before anything was sent or written */
+            422: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `internal`: a bug: logged with the request id */
+            500: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `communication`: the drive or the link failed part-way (incomplete backup or restore) */
+            502: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `unavailable`: the bus is not connected, or an axis's drive cannot be reached */
+            503: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `timeout`: the drive did not answer in time */
+            504: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+        };
+    };
+    home_api_buses__bus__nodes__node__motion_home_post: {
+        parameters: {
+            query?: {
+                /** @description device key (xtrapulspac, cd1k, …) overriding the identified one; by default the node is identified on first use */
+                device?: string | null;
+            };
+            header?: {
+                /** @description id announced by /api/ws/events; required for motion */
+                "X-Servo-Client"?: string | null;
+            };
+            path: {
+                bus: string;
+                node: number;
+            };
+            cookie?: never;
+        };
+        requestBody: {
+            content: {
+                "application/json": components["schemas"]["HomeBody"];
+            };
+        };
+        responses: {
+            /** @description Successful Response */
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["MotionModel"];
+                };
+            };
+            /** @description `not_found`: unknown bus, node, job, object, device, project, axis or motor */
+            404: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `refused_for_safety`: refused to keep the machine safe (no live client, drive enabled) */
+            409: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `invalid_input`: refused before anything was sent or written */
+            422: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `internal`: a bug: logged with the request id */
+            500: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `communication`: the drive or the link failed part-way (incomplete backup or restore) */
+            502: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `unavailable`: the bus is not connected, or an axis's drive cannot be reached */
+            503: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `timeout`: the drive did not answer in time */
+            504: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+        };
+    };
+    jog_api_buses__bus__nodes__node__motion_jog_post: {
+        parameters: {
+            query?: {
+                /** @description device key (xtrapulspac, cd1k, …) overriding the identified one; by default the node is identified on first use */
+                device?: string | null;
+            };
+            header?: {
+                /** @description id announced by /api/ws/events; required for motion */
+                "X-Servo-Client"?: string | null;
+            };
+            path: {
+                bus: string;
+                node: number;
+            };
+            cookie?: never;
+        };
+        requestBody: {
+            content: {
+                "application/json": components["schemas"]["JogBody"];
+            };
+        };
+        responses: {
+            /** @description Successful Response */
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["MotionModel"];
+                };
+            };
+            /** @description `not_found`: unknown bus, node, job, object, device, project, axis or motor */
+            404: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `refused_for_safety`: refused to keep the machine safe (no live client, drive enabled) */
+            409: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `invalid_input`: refused before anything was sent or written */
+            422: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `internal`: a bug: logged with the request id */
+            500: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `communication`: the drive or the link failed part-way (incomplete backup or restore) */
+            502: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `unavailable`: the bus is not connected, or an axis's drive cannot be reached */
+            503: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `timeout`: the drive did not answer in time */
+            504: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+        };
+    };
+    get_limits_api_buses__bus__nodes__node__motion_limits_get: {
+        parameters: {
+            query?: never;
+            header?: {
+                /** @description id announced by /api/ws/events; required for motion */
+                "X-Servo-Client"?: string | null;
+            };
+            path: {
+                /** @description node ID */
+                node: number;
+                bus: string;
+            };
+            cookie?: never;
+        };
+        requestBody?: never;
+        responses: {
+            /** @description Successful Response */
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["LimitsModel"];
+                };
+            };
+            /** @description `not_found`: unknown bus, node, job, object, device, project, axis or motor */
+            404: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `conflict`: the current state refuses it: a changed project, a taken name, the drive; `refused_for_safety`: refused to keep the machine safe (no live client, drive enabled) */
+            409: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `invalid_input`: refused before anything was sent or written */
+            422: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `internal`: a bug: logged with the request id */
+            500: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `communication`: the drive or the link failed part-way (incomplete backup or restore) */
+            502: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `unavailable`: the bus is not connected, or an axis's drive cannot be reached */
+            503: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `timeout`: the drive did not answer in time */
+            504: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+        };
+    };
+    set_limits_api_buses__bus__nodes__node__motion_limits_put: {
+        parameters: {
+            query?: never;
+            header?: {
+                /** @description id announced by /api/ws/events; required for motion */
+                "X-Servo-Client"?: string | null;
+            };
+            path: {
+                /** @description node ID */
+                node: number;
+                bus: string;
+            };
+            cookie?: never;
+        };
+        requestBody: {
+            content: {
+                "application/json": components["schemas"]["LimitsBody"];
+            };
+        };
+        responses: {
+            /** @description Successful Response */
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["LimitsModel"];
+                };
+            };
+            /** @description `not_found`: unknown bus, node, job, object, device, project, axis or motor */
+            404: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `conflict`: the current state refuses it: a changed project, a taken name, the drive; `refused_for_safety`: refused to keep the machine safe (no live client, drive enabled) */
+            409: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `invalid_input`: refused before anything was sent or written */
+            422: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `internal`: a bug: logged with the request id */
+            500: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `communication`: the drive or the link failed part-way (incomplete backup or restore) */
+            502: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `unavailable`: the bus is not connected, or an axis's drive cannot be reached */
+            503: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `timeout`: the drive did not answer in time */
+            504: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+        };
+    };
+    move_api_buses__bus__nodes__node__motion_move_post: {
+        parameters: {
+            query?: {
+                /** @description device key (xtrapulspac, cd1k, …) overriding the identified one; by default the node is identified on first use */
+                device?: string | null;
+            };
+            header?: {
+                /** @description id announced by /api/ws/events; required for motion */
+                "X-Servo-Client"?: string | null;
+            };
+            path: {
+                bus: string;
+                node: number;
+            };
+            cookie?: never;
+        };
+        requestBody: {
+            content: {
+                "application/json": components["schemas"]["MoveBody"];
+            };
+        };
+        responses: {
+            /** @description Successful Response */
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["MotionModel"];
+                };
+            };
+            /** @description `not_found`: unknown bus, node, job, object, device, project, axis or motor */
+            404: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `refused_for_safety`: refused to keep the machine safe (no live client, drive enabled) */
+            409: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `invalid_input`: refused before anything was sent or written */
+            422: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `internal`: a bug: logged with the request id */
+            500: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `communication`: the drive or the link failed part-way (incomplete backup or restore) */
+            502: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `unavailable`: the bus is not connected, or an axis's drive cannot be reached */
+            503: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `timeout`: the drive did not answer in time */
+            504: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+        };
+    };
+    stop_api_buses__bus__nodes__node__motion_stop_post: {
+        parameters: {
+            query?: {
+                /** @description device key (xtrapulspac, cd1k, …) overriding the identified one; by default the node is identified on first use */
+                device?: string | null;
+            };
+            header?: {
+                /** @description id announced by /api/ws/events; required for motion */
+                "X-Servo-Client"?: string | null;
+            };
+            path: {
+                bus: string;
+                node: number;
+            };
+            cookie?: never;
+        };
+        requestBody?: never;
+        responses: {
+            /** @description Successful Response */
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["MotionModel"];
+                };
+            };
+            /** @description `not_found`: unknown bus, node, job, object, device, project, axis or motor */
+            404: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `conflict`: the current state refuses it: a changed project, a taken name, the drive; `refused_for_safety`: refused to keep the machine safe (no live client, drive enabled) */
+            409: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `invalid_input`: refused before anything was sent or written */
+            422: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `internal`: a bug: logged with the request id */
+            500: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `communication`: the drive or the link failed part-way (incomplete backup or restore) */
+            502: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `unavailable`: the bus is not connected, or an axis's drive cannot be reached */
+            503: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `timeout`: the drive did not answer in time */
+            504: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+        };
+    };
     read_object_api_buses__bus__nodes__node__objects__key__get: {
         parameters: {
             query?: {
@@ -4254,6 +6389,291 @@ export interface operations {
                 };
                 content: {
                     "application/json": components["schemas"]["ObjectValueModel"];
+                };
+            };
+            /** @description `not_found`: unknown bus, node, job, object, device, project, axis or motor */
+            404: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `conflict`: the current state refuses it: a changed project, a taken name, the drive; `refused_for_safety`: refused to keep the machine safe (no live client, drive enabled) */
+            409: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `invalid_input`: refused before anything was sent or written */
+            422: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `internal`: a bug: logged with the request id */
+            500: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `communication`: the drive or the link failed part-way (incomplete backup or restore) */
+            502: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `unavailable`: the bus is not connected, or an axis's drive cannot be reached */
+            503: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `timeout`: the drive did not answer in time */
+            504: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+        };
+    };
+    list_procedures_api_buses__bus__nodes__node__procedures_get: {
+        parameters: {
+            query?: {
+                /** @description device key (xtrapulspac, cd1k, …) overriding the identified one; by default the node is identified on first use */
+                device?: string | null;
+            };
+            header?: {
+                /** @description id announced by /api/ws/events; required for motion */
+                "X-Servo-Client"?: string | null;
+            };
+            path: {
+                node: number;
+                bus: string;
+            };
+            cookie?: never;
+        };
+        requestBody?: never;
+        responses: {
+            /** @description Successful Response */
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ProcedureModel"][];
+                };
+            };
+            /** @description `not_found`: unknown bus, node, job, object, device, project, axis or motor */
+            404: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `conflict`: the current state refuses it: a changed project, a taken name, the drive; `refused_for_safety`: refused to keep the machine safe (no live client, drive enabled) */
+            409: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `invalid_input`: refused before anything was sent or written */
+            422: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `internal`: a bug: logged with the request id */
+            500: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `communication`: the drive or the link failed part-way (incomplete backup or restore) */
+            502: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `unavailable`: the bus is not connected, or an axis's drive cannot be reached */
+            503: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `timeout`: the drive did not answer in time */
+            504: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+        };
+    };
+    undo_tuning_api_buses__bus__nodes__node__procedures_auto_tuning_undo_post: {
+        parameters: {
+            query?: {
+                /** @description device key (xtrapulspac, cd1k, …) overriding the identified one; by default the node is identified on first use */
+                device?: string | null;
+            };
+            header?: {
+                /** @description id announced by /api/ws/events; required for motion */
+                "X-Servo-Client"?: string | null;
+            };
+            path: {
+                node: number;
+                bus: string;
+            };
+            cookie?: never;
+        };
+        requestBody: {
+            content: {
+                "application/json": components["schemas"]["UndoRequest"];
+            };
+        };
+        responses: {
+            /** @description Successful Response */
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["UndoResult"];
+                };
+            };
+            /** @description `not_found`: unknown bus, node, job, object, device, project, axis or motor */
+            404: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `conflict`: the current state refuses it: a changed project, a taken name, the drive; `refused_for_safety`: refused to keep the machine safe (no live client, drive enabled) */
+            409: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `invalid_input`: refused before anything was sent or written */
+            422: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `internal`: a bug: logged with the request id */
+            500: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `communication`: the drive or the link failed part-way (incomplete backup or restore) */
+            502: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `unavailable`: the bus is not connected, or an axis's drive cannot be reached */
+            503: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `timeout`: the drive did not answer in time */
+            504: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+        };
+    };
+    start_procedure_api_buses__bus__nodes__node__procedures__name__post: {
+        parameters: {
+            query?: {
+                /** @description device key (xtrapulspac, cd1k, …) overriding the identified one; by default the node is identified on first use */
+                device?: string | null;
+            };
+            header?: {
+                /** @description id announced by /api/ws/events; required for motion */
+                "X-Servo-Client"?: string | null;
+            };
+            path: {
+                name: string;
+                bus: string;
+                node: number;
+            };
+            cookie?: never;
+        };
+        requestBody: {
+            content: {
+                "application/json": components["schemas"]["ProcedureStart"];
+            };
+        };
+        responses: {
+            /** @description Successful Response */
+            202: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["JobModel"];
                 };
             };
             /** @description `not_found`: unknown bus, node, job, object, device, project, axis or motor */
@@ -4769,8 +7189,8 @@ export interface operations {
                 "X-Servo-Client"?: string | null;
             };
             path: {
-                node: number;
                 bus: string;
+                node: number;
             };
             cookie?: never;
         };
@@ -5063,6 +7483,937 @@ export interface operations {
                 };
                 content: {
                     "application/json": components["schemas"]["RecorderStatus"];
+                };
+            };
+            /** @description `not_found`: unknown bus, node, job, object, device, project, axis or motor */
+            404: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `conflict`: the current state refuses it: a changed project, a taken name, the drive; `refused_for_safety`: refused to keep the machine safe (no live client, drive enabled) */
+            409: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `invalid_input`: refused before anything was sent or written */
+            422: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `internal`: a bug: logged with the request id */
+            500: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `communication`: the drive or the link failed part-way (incomplete backup or restore) */
+            502: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `unavailable`: the bus is not connected, or an axis's drive cannot be reached */
+            503: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `timeout`: the drive did not answer in time */
+            504: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+        };
+    };
+    upload_api_buses__bus__nodes__node__sequences_get: {
+        parameters: {
+            query?: {
+                /** @description device key (xtrapulspac, cd1k, …) overriding the identified one; by default the node is identified on first use */
+                device?: string | null;
+            };
+            header?: {
+                /** @description id announced by /api/ws/events; required for motion */
+                "X-Servo-Client"?: string | null;
+            };
+            path: {
+                node: number;
+                bus: string;
+            };
+            cookie?: never;
+        };
+        requestBody?: never;
+        responses: {
+            /** @description Successful Response */
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["DriveSequencesModel"];
+                };
+            };
+            /** @description `not_found`: unknown bus, node, job, object, device, project, axis or motor */
+            404: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `conflict`: the current state refuses it: a changed project, a taken name, the drive; `refused_for_safety`: refused to keep the machine safe (no live client, drive enabled) */
+            409: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `invalid_input`: refused before anything was sent or written */
+            422: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `internal`: a bug: logged with the request id */
+            500: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `communication`: the drive or the link failed part-way (incomplete backup or restore) */
+            502: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `unavailable`: the bus is not connected, or an axis's drive cannot be reached */
+            503: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `timeout`: the drive did not answer in time */
+            504: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+        };
+    };
+    download_api_buses__bus__nodes__node__sequences_put: {
+        parameters: {
+            query?: {
+                /** @description device key (xtrapulspac, cd1k, …) overriding the identified one; by default the node is identified on first use */
+                device?: string | null;
+            };
+            header?: {
+                /** @description id announced by /api/ws/events; required for motion */
+                "X-Servo-Client"?: string | null;
+            };
+            path: {
+                node: number;
+                bus: string;
+            };
+            cookie?: never;
+        };
+        requestBody: {
+            content: {
+                "application/json": components["schemas"]["DownloadRequest"];
+            };
+        };
+        responses: {
+            /** @description Successful Response */
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["DownloadModel"];
+                };
+            };
+            /** @description `not_found`: unknown bus, node, job, object, device, project, axis or motor */
+            404: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `conflict`: the current state refuses it: a changed project, a taken name, the drive; `refused_for_safety`: refused to keep the machine safe (no live client, drive enabled) */
+            409: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `invalid_input`: refused before anything was sent or written */
+            422: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `internal`: a bug: logged with the request id */
+            500: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `communication`: the drive or the link failed part-way (incomplete backup or restore) */
+            502: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `unavailable`: the bus is not connected, or an axis's drive cannot be reached */
+            503: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `timeout`: the drive did not answer in time */
+            504: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+        };
+    };
+    inputs_api_buses__bus__nodes__node__sequences_inputs_put: {
+        parameters: {
+            query?: {
+                /** @description device key (xtrapulspac, cd1k, …) overriding the identified one; by default the node is identified on first use */
+                device?: string | null;
+            };
+            header?: {
+                /** @description id announced by /api/ws/events; required for motion */
+                "X-Servo-Client"?: string | null;
+            };
+            path: {
+                node: number;
+                bus: string;
+            };
+            cookie?: never;
+        };
+        requestBody: {
+            content: {
+                "application/json": components["schemas"]["InputsRequest"];
+            };
+        };
+        responses: {
+            /** @description Successful Response */
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["InputsModel"];
+                };
+            };
+            /** @description `not_found`: unknown bus, node, job, object, device, project, axis or motor */
+            404: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `conflict`: the current state refuses it: a changed project, a taken name, the drive; `refused_for_safety`: refused to keep the machine safe (no live client, drive enabled) */
+            409: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `invalid_input`: refused before anything was sent or written */
+            422: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `internal`: a bug: logged with the request id */
+            500: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `communication`: the drive or the link failed part-way (incomplete backup or restore) */
+            502: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `unavailable`: the bus is not connected, or an axis's drive cannot be reached */
+            503: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `timeout`: the drive did not answer in time */
+            504: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+        };
+    };
+    read_monitor_api_buses__bus__nodes__node__sequences_monitor_get: {
+        parameters: {
+            query?: {
+                since?: number;
+            };
+            header?: {
+                /** @description id announced by /api/ws/events; required for motion */
+                "X-Servo-Client"?: string | null;
+            };
+            path: {
+                node: number;
+                bus: string;
+            };
+            cookie?: never;
+        };
+        requestBody?: never;
+        responses: {
+            /** @description Successful Response */
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["MonitorModel"];
+                };
+            };
+            /** @description `not_found`: unknown bus, node, job, object, device, project, axis or motor */
+            404: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `conflict`: the current state refuses it: a changed project, a taken name, the drive; `refused_for_safety`: refused to keep the machine safe (no live client, drive enabled) */
+            409: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `invalid_input`: refused before anything was sent or written */
+            422: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `internal`: a bug: logged with the request id */
+            500: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `communication`: the drive or the link failed part-way (incomplete backup or restore) */
+            502: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `unavailable`: the bus is not connected, or an axis's drive cannot be reached */
+            503: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `timeout`: the drive did not answer in time */
+            504: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+        };
+    };
+    start_monitor_api_buses__bus__nodes__node__sequences_monitor_post: {
+        parameters: {
+            query?: {
+                fresh?: boolean;
+                /** @description device key (xtrapulspac, cd1k, …) overriding the identified one; by default the node is identified on first use */
+                device?: string | null;
+            };
+            header?: {
+                /** @description id announced by /api/ws/events; required for motion */
+                "X-Servo-Client"?: string | null;
+            };
+            path: {
+                bus: string;
+                node: number;
+            };
+            cookie?: never;
+        };
+        requestBody?: never;
+        responses: {
+            /** @description Successful Response */
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["MonitorModel"];
+                };
+            };
+            /** @description `not_found`: unknown bus, node, job, object, device, project, axis or motor */
+            404: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `conflict`: the current state refuses it: a changed project, a taken name, the drive; `refused_for_safety`: refused to keep the machine safe (no live client, drive enabled) */
+            409: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `invalid_input`: refused before anything was sent or written */
+            422: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `internal`: a bug: logged with the request id */
+            500: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `communication`: the drive or the link failed part-way (incomplete backup or restore) */
+            502: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `unavailable`: the bus is not connected, or an axis's drive cannot be reached */
+            503: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `timeout`: the drive did not answer in time */
+            504: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+        };
+    };
+    stop_monitor_api_buses__bus__nodes__node__sequences_monitor_delete: {
+        parameters: {
+            query?: never;
+            header?: {
+                /** @description id announced by /api/ws/events; required for motion */
+                "X-Servo-Client"?: string | null;
+            };
+            path: {
+                node: number;
+                bus: string;
+            };
+            cookie?: never;
+        };
+        requestBody?: never;
+        responses: {
+            /** @description Successful Response */
+            204: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content?: never;
+            };
+            /** @description `not_found`: unknown bus, node, job, object, device, project, axis or motor */
+            404: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `conflict`: the current state refuses it: a changed project, a taken name, the drive; `refused_for_safety`: refused to keep the machine safe (no live client, drive enabled) */
+            409: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `invalid_input`: refused before anything was sent or written */
+            422: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `internal`: a bug: logged with the request id */
+            500: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `communication`: the drive or the link failed part-way (incomplete backup or restore) */
+            502: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `unavailable`: the bus is not connected, or an axis's drive cannot be reached */
+            503: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `timeout`: the drive did not answer in time */
+            504: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+        };
+    };
+    reload_api_buses__bus__nodes__node__sequences_reload_post: {
+        parameters: {
+            query?: {
+                /** @description device key (xtrapulspac, cd1k, …) overriding the identified one; by default the node is identified on first use */
+                device?: string | null;
+            };
+            header?: {
+                /** @description id announced by /api/ws/events; required for motion */
+                "X-Servo-Client"?: string | null;
+            };
+            path: {
+                node: number;
+                bus: string;
+            };
+            cookie?: never;
+        };
+        requestBody: {
+            content: {
+                "application/json": components["schemas"]["ReloadRequest"];
+            };
+        };
+        responses: {
+            /** @description Successful Response */
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["RunModel"];
+                };
+            };
+            /** @description `not_found`: unknown bus, node, job, object, device, project, axis or motor */
+            404: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `conflict`: the current state refuses it: a changed project, a taken name, the drive; `refused_for_safety`: refused to keep the machine safe (no live client, drive enabled) */
+            409: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `invalid_input`: refused before anything was sent or written */
+            422: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `internal`: a bug: logged with the request id */
+            500: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `communication`: the drive or the link failed part-way (incomplete backup or restore) */
+            502: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `unavailable`: the bus is not connected, or an axis's drive cannot be reached */
+            503: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `timeout`: the drive did not answer in time */
+            504: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+        };
+    };
+    start_api_buses__bus__nodes__node__sequences_start_post: {
+        parameters: {
+            query?: {
+                /** @description device key (xtrapulspac, cd1k, …) overriding the identified one; by default the node is identified on first use */
+                device?: string | null;
+            };
+            header?: {
+                /** @description id announced by /api/ws/events; required for motion */
+                "X-Servo-Client"?: string | null;
+            };
+            path: {
+                bus: string;
+                node: number;
+            };
+            cookie?: never;
+        };
+        requestBody: {
+            content: {
+                "application/json": components["schemas"]["StartRequest"];
+            };
+        };
+        responses: {
+            /** @description Successful Response */
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["RunModel"];
+                };
+            };
+            /** @description `not_found`: unknown bus, node, job, object, device, project, axis or motor */
+            404: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `conflict`: the current state refuses it: a changed project, a taken name, the drive; `refused_for_safety`: refused to keep the machine safe (no live client, drive enabled) */
+            409: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `invalid_input`: refused before anything was sent or written */
+            422: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `internal`: a bug: logged with the request id */
+            500: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `communication`: the drive or the link failed part-way (incomplete backup or restore) */
+            502: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `unavailable`: the bus is not connected, or an axis's drive cannot be reached */
+            503: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `timeout`: the drive did not answer in time */
+            504: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+        };
+    };
+    stop_api_buses__bus__nodes__node__sequences_stop_post: {
+        parameters: {
+            query?: {
+                /** @description device key (xtrapulspac, cd1k, …) overriding the identified one; by default the node is identified on first use */
+                device?: string | null;
+            };
+            header?: {
+                /** @description id announced by /api/ws/events; required for motion */
+                "X-Servo-Client"?: string | null;
+            };
+            path: {
+                node: number;
+                bus: string;
+            };
+            cookie?: never;
+        };
+        requestBody?: never;
+        responses: {
+            /** @description Successful Response */
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["RunModel"];
+                };
+            };
+            /** @description `not_found`: unknown bus, node, job, object, device, project, axis or motor */
+            404: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `conflict`: the current state refuses it: a changed project, a taken name, the drive; `refused_for_safety`: refused to keep the machine safe (no live client, drive enabled) */
+            409: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `invalid_input`: refused before anything was sent or written */
+            422: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `internal`: a bug: logged with the request id */
+            500: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `communication`: the drive or the link failed part-way (incomplete backup or restore) */
+            502: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `unavailable`: the bus is not connected, or an axis's drive cannot be reached */
+            503: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `timeout`: the drive did not answer in time */
+            504: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+        };
+    };
+    store_api_buses__bus__nodes__node__sequences_store_post: {
+        parameters: {
+            query?: {
+                /** @description device key (xtrapulspac, cd1k, …) overriding the identified one; by default the node is identified on first use */
+                device?: string | null;
+            };
+            header?: {
+                /** @description id announced by /api/ws/events; required for motion */
+                "X-Servo-Client"?: string | null;
+            };
+            path: {
+                node: number;
+                bus: string;
+            };
+            cookie?: never;
+        };
+        requestBody?: never;
+        responses: {
+            /** @description Successful Response */
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["RunModel"];
                 };
             };
             /** @description `not_found`: unknown bus, node, job, object, device, project, axis or motor */
@@ -5446,6 +8797,218 @@ export interface operations {
             };
         };
     };
+    get_share_api_buses__bus__share_get: {
+        parameters: {
+            query?: never;
+            header?: {
+                /** @description id announced by /api/ws/events; required for motion */
+                "X-Servo-Client"?: string | null;
+            };
+            path: {
+                bus: string;
+            };
+            cookie?: never;
+        };
+        requestBody?: never;
+        responses: {
+            /** @description Successful Response */
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ShareModel"];
+                };
+            };
+            /** @description `not_found`: unknown bus, node, job, object, device, project, axis or motor */
+            404: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `conflict`: the current state refuses it: a changed project, a taken name, the drive */
+            409: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `invalid_input`: refused before anything was sent or written */
+            422: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `internal`: a bug: logged with the request id */
+            500: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `unavailable`: the bus is not connected, or an axis's drive cannot be reached */
+            503: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+        };
+    };
+    put_share_api_buses__bus__share_put: {
+        parameters: {
+            query?: never;
+            header?: {
+                /** @description id announced by /api/ws/events; required for motion */
+                "X-Servo-Client"?: string | null;
+            };
+            path: {
+                bus: string;
+            };
+            cookie?: never;
+        };
+        requestBody: {
+            content: {
+                "application/json": components["schemas"]["ShareRequest"];
+            };
+        };
+        responses: {
+            /** @description Successful Response */
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ShareModel"];
+                };
+            };
+            /** @description `not_found`: unknown bus, node, job, object, device, project, axis or motor */
+            404: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `conflict`: the current state refuses it: a changed project, a taken name, the drive */
+            409: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `invalid_input`: refused before anything was sent or written */
+            422: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `internal`: a bug: logged with the request id */
+            500: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `unavailable`: the bus is not connected, or an axis's drive cannot be reached */
+            503: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+        };
+    };
+    delete_share_api_buses__bus__share_delete: {
+        parameters: {
+            query?: never;
+            header?: {
+                /** @description id announced by /api/ws/events; required for motion */
+                "X-Servo-Client"?: string | null;
+            };
+            path: {
+                bus: string;
+            };
+            cookie?: never;
+        };
+        requestBody?: never;
+        responses: {
+            /** @description Successful Response */
+            204: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content?: never;
+            };
+            /** @description `not_found`: unknown bus, node, job, object, device, project, axis or motor */
+            404: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `conflict`: the current state refuses it: a changed project, a taken name, the drive */
+            409: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `invalid_input`: refused before anything was sent or written */
+            422: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `internal`: a bug: logged with the request id */
+            500: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `unavailable`: the bus is not connected, or an axis's drive cannot be reached */
+            503: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+        };
+    };
     list_controls_api_control_get: {
         parameters: {
             query?: never;
@@ -5727,6 +9290,91 @@ export interface operations {
             };
             /** @description `internal`: a bug: logged with the request id */
             500: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+        };
+    };
+    homing_methods_api_homing_methods__device__get: {
+        parameters: {
+            query?: never;
+            header?: never;
+            path: {
+                device: string;
+            };
+            cookie?: never;
+        };
+        requestBody?: never;
+        responses: {
+            /** @description Successful Response */
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["HomingMethodModel"][];
+                };
+            };
+            /** @description `not_found`: unknown bus, node, job, object, device, project, axis or motor */
+            404: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `conflict`: the current state refuses it: a changed project, a taken name, the drive; `refused_for_safety`: refused to keep the machine safe (no live client, drive enabled) */
+            409: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `invalid_input`: refused before anything was sent or written */
+            422: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `internal`: a bug: logged with the request id */
+            500: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `communication`: the drive or the link failed part-way (incomplete backup or restore) */
+            502: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `unavailable`: the bus is not connected, or an axis's drive cannot be reached */
+            503: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `timeout`: the drive did not answer in time */
+            504: {
                 headers: {
                     [name: string]: unknown;
                 };
@@ -6952,6 +10600,7 @@ export interface operations {
                 group?: string | null;
                 only_differences?: boolean;
                 drive?: boolean;
+                read_only?: boolean;
             };
             header?: {
                 /** @description id announced by /api/ws/events; required for motion */
@@ -7456,6 +11105,188 @@ export interface operations {
             };
         };
     };
+    read_project_api_projects__name__axes__axis__sequences_get: {
+        parameters: {
+            query?: never;
+            header?: {
+                /** @description id announced by /api/ws/events; required for motion */
+                "X-Servo-Client"?: string | null;
+            };
+            path: {
+                name: string;
+                axis: string;
+            };
+            cookie?: never;
+        };
+        requestBody?: never;
+        responses: {
+            /** @description Successful Response */
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ProjectSequences"];
+                };
+            };
+            /** @description `not_found`: unknown bus, node, job, object, device, project, axis or motor */
+            404: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `conflict`: the current state refuses it: a changed project, a taken name, the drive; `refused_for_safety`: refused to keep the machine safe (no live client, drive enabled) */
+            409: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `invalid_input`: refused before anything was sent or written */
+            422: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `internal`: a bug: logged with the request id */
+            500: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `communication`: the drive or the link failed part-way (incomplete backup or restore) */
+            502: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `unavailable`: the bus is not connected, or an axis's drive cannot be reached */
+            503: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `timeout`: the drive did not answer in time */
+            504: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+        };
+    };
+    write_project_api_projects__name__axes__axis__sequences_put: {
+        parameters: {
+            query?: never;
+            header?: {
+                /** @description id announced by /api/ws/events; required for motion */
+                "X-Servo-Client"?: string | null;
+            };
+            path: {
+                name: string;
+                axis: string;
+            };
+            cookie?: never;
+        };
+        requestBody: {
+            content: {
+                "application/json": components["schemas"]["ProjectSequencesWrite"];
+            };
+        };
+        responses: {
+            /** @description Successful Response */
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ProjectSequences"];
+                };
+            };
+            /** @description `not_found`: unknown bus, node, job, object, device, project, axis or motor */
+            404: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `conflict`: the current state refuses it: a changed project, a taken name, the drive; `refused_for_safety`: refused to keep the machine safe (no live client, drive enabled) */
+            409: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `invalid_input`: refused before anything was sent or written */
+            422: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `internal`: a bug: logged with the request id */
+            500: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `communication`: the drive or the link failed part-way (incomplete backup or restore) */
+            502: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `unavailable`: the bus is not connected, or an axis's drive cannot be reached */
+            503: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `timeout`: the drive did not answer in time */
+            504: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+        };
+    };
     take_from_drive_api_projects__name__axes__axis__take_from_drive_post: {
         parameters: {
             query?: never;
@@ -7814,6 +11645,133 @@ export interface operations {
         requestBody: {
             content: {
                 "application/json": components["schemas"]["NewName"];
+            };
+        };
+        responses: {
+            /** @description Successful Response */
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ProjectModel"];
+                };
+            };
+            /** @description `not_found`: unknown bus, node, job, object, device, project, axis or motor */
+            404: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `conflict`: the current state refuses it: a changed project, a taken name, the drive */
+            409: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `invalid_input`: refused before anything was sent or written */
+            422: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `internal`: a bug: logged with the request id */
+            500: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+        };
+    };
+    list_revisions_api_projects__name__revisions_get: {
+        parameters: {
+            query?: never;
+            header?: {
+                /** @description id announced by /api/ws/events; required for motion */
+                "X-Servo-Client"?: string | null;
+            };
+            path: {
+                name: string;
+            };
+            cookie?: never;
+        };
+        requestBody?: never;
+        responses: {
+            /** @description Successful Response */
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["KeptRevisionModel"][];
+                };
+            };
+            /** @description `not_found`: unknown bus, node, job, object, device, project, axis or motor */
+            404: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `conflict`: the current state refuses it: a changed project, a taken name, the drive */
+            409: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `invalid_input`: refused before anything was sent or written */
+            422: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `internal`: a bug: logged with the request id */
+            500: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+        };
+    };
+    restore_revision_api_projects__name__revisions__revision__restore_post: {
+        parameters: {
+            query?: never;
+            header?: {
+                /** @description id announced by /api/ws/events; required for motion */
+                "X-Servo-Client"?: string | null;
+            };
+            path: {
+                name: string;
+                revision: string;
+            };
+            cookie?: never;
+        };
+        requestBody: {
+            content: {
+                "application/json": components["schemas"]["RevisionRestore"];
             };
         };
         responses: {
@@ -8325,6 +12283,231 @@ export interface operations {
             };
             /** @description `internal`: a bug: logged with the request id */
             500: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+        };
+    };
+    list_saved_api_projects__project__axes__axis__procedures_get: {
+        parameters: {
+            query?: never;
+            header?: {
+                /** @description id announced by /api/ws/events; required for motion */
+                "X-Servo-Client"?: string | null;
+            };
+            path: {
+                project: string;
+                axis: string;
+            };
+            cookie?: never;
+        };
+        requestBody?: never;
+        responses: {
+            /** @description Successful Response */
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": {
+                        [key: string]: unknown;
+                    }[];
+                };
+            };
+            /** @description `not_found`: unknown bus, node, job, object, device, project, axis or motor */
+            404: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `invalid_input`: refused before anything was sent or written */
+            422: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `internal`: a bug: logged with the request id */
+            500: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+        };
+    };
+    check_api_sequences_check_post: {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        requestBody: {
+            content: {
+                "application/json": components["schemas"]["SequenceText"];
+            };
+        };
+        responses: {
+            /** @description Successful Response */
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["CheckModel"];
+                };
+            };
+            /** @description `not_found`: unknown bus, node, job, object, device, project, axis or motor */
+            404: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `conflict`: the current state refuses it: a changed project, a taken name, the drive; `refused_for_safety`: refused to keep the machine safe (no live client, drive enabled) */
+            409: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `invalid_input`: refused before anything was sent or written */
+            422: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `internal`: a bug: logged with the request id */
+            500: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `communication`: the drive or the link failed part-way (incomplete backup or restore) */
+            502: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `unavailable`: the bus is not connected, or an axis's drive cannot be reached */
+            503: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `timeout`: the drive did not answer in time */
+            504: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+        };
+    };
+    keywords_api_sequences_keywords_get: {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        requestBody?: never;
+        responses: {
+            /** @description Successful Response */
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["CatalogModel"];
+                };
+            };
+            /** @description `not_found`: unknown bus, node, job, object, device, project, axis or motor */
+            404: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `conflict`: the current state refuses it: a changed project, a taken name, the drive; `refused_for_safety`: refused to keep the machine safe (no live client, drive enabled) */
+            409: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `invalid_input`: refused before anything was sent or written */
+            422: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `internal`: a bug: logged with the request id */
+            500: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `communication`: the drive or the link failed part-way (incomplete backup or restore) */
+            502: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `unavailable`: the bus is not connected, or an axis's drive cannot be reached */
+            503: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `timeout`: the drive did not answer in time */
+            504: {
                 headers: {
                     [name: string]: unknown;
                 };

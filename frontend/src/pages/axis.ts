@@ -10,6 +10,9 @@ import { backupView } from "./backup";
 import { commissioningView } from "./commissioning";
 import { dashboardView } from "./dashboard";
 import { parametersView } from "./axisparams";
+import { currentLoopView } from "./currentloop";
+import { phasingView } from "./phasing";
+import { sequencesView } from "./sequences";
 
 export interface AxisContext {
   page: PageContext;
@@ -33,6 +36,10 @@ const VIEWS: [AxisView, string, string][] = [
   ["commissioning", "Commissioning", "g c"],
   ["backup", "Backup / restore", "g k"],
   ["scope", "Scope", "g s"],
+  ["current-loop", "Current loop", ""],
+  ["phasing", "Phasing", ""],
+  ["tuning", "Auto-tuning", ""],
+  ["sequences", "Sequences", ""],
 ];
 
 export async function axisPage(context: PageContext, projectName: string, axisName: string, view: AxisView): Promise<Page> {
@@ -52,7 +59,11 @@ export async function axisPage(context: PageContext, projectName: string, axisNa
     : view === "parameters" ? parametersView(axisContext)
       : view === "commissioning" ? commissioningView(axisContext)
         : view === "scope" ? import("./scope").then((module) => module.scopeView(axisContext)) // plotly only here
-          : backupView(axisContext));
+          : view === "current-loop" ? currentLoopView(axisContext)
+            : view === "phasing" ? phasingView(axisContext)
+              : view === "tuning" ? import("./tuning").then((module) => module.tuningView(axisContext)) // plots with plotly
+                : view === "sequences" ? sequencesView(axisContext)
+                  : backupView(axisContext));
 
   // The header follows the live hub, which outlives the page: its binding is stopped with the page's scope.
   const scope = new Scope();
@@ -63,7 +74,7 @@ export async function axisPage(context: PageContext, projectName: string, axisNa
   }));
   const tabs = h("nav", { class: "tabs" }, VIEWS.map(([key, label, keys]) => h("a", {
     href: buildPath({ page: "axis", project: project.name, axis: axis.name, view: key }),
-    class: key === view ? "active" : "", title: `${label} (${keys})`, "data-testid": `tab-${key}`,
+    class: key === view ? "active" : "", title: keys ? `${label} (${keys})` : label, "data-testid": `tab-${key}`,
   }, label)));
   const head = h("div", { class: "page-head" },
     h("h1", { "data-testid": "axis-title" }, axis.name),

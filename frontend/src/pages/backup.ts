@@ -4,14 +4,16 @@
  * cancelled between objects.
  */
 
-import { errorOf, projectAddress, projects, request, setParametersSkipping } from "../client/api";
+import { errorOf, projectAddress, projects, request, setParametersSkipping, type KeptRevision, type ProjectParameter } from "../client/api";
 import { driveApi } from "../client/drives";
 import { runJob, type JobInfo } from "../client/jobs";
 import type { RestoreResult } from "../client/messages";
+import { confirmChanges, type Change } from "../components/confirm/changes";
 import { confirmAction, errorText, messageView, pickFile, type Message } from "../components/ui";
 import { h, state, type State } from "../lib/dom";
-import { entries, isReadable, isWritable, type Dictionary, type Entry } from "../lib/od";
-import { unstorableReason } from "../lib/values";
+import { objectFiles } from "../lib/objectfile";
+import { entries, entryKey, isReadable, isWritable, type Dictionary, type Entry, type Scalar } from "../lib/od";
+import { formatValue, sameValue, unstorableReason } from "../lib/values";
 import type { AxisContext, AxisViewPage } from "./axis";
 
 const CHUNK = 40;
@@ -22,6 +24,8 @@ const SAVE_SIGNATURE = 0x65766173;
 interface Outcome {
   text: string;
   warning: boolean;
+  /** Every entry the text counts but does not name (values left out and why), listed under the message. */
+  notes?: string[];
   /** Set by a server job, which knows whether Cancel reached it before it ended. */
   cancelled?: boolean;
 }
@@ -42,11 +46,18 @@ interface BackupView {
   node: number;
   running: State<Run | null>;
   result: State<Message | null>;
+  notes: State<string[]>;
+  /** The project's newest kept revision (what the last backup into the project replaced). */
+  kept: State<KeptRevision | null>;
 }
 
 export async function backupView(context: AxisContext): Promise<AxisViewPage> {
   const { project, axis, dictionary } = context;
-  const view: BackupView = { context, bus: axis.bus, node: axis.node_id, running: state<Run | null>(null), result: state<Message | null>(null) };
+  const view: BackupView = {
+    context, bus: axis.bus, node: axis.node_id, running: state<Run | null>(null), result: state<Message | null>(null),
+    notes: state<string[]>([]), kept: state<KeptRevision | null>(null),
+  };
+  void loadKept(view);
   const saved = savedEntries(dictionary);
   const button = (label: string, action: () => Promise<void>, testid: string, primary = false) =>
     h("button", { class: primary ? "primary" : "", "data-testid": testid, disabled: () => view.running.val !== null, onclick: () => void action() }, label);
@@ -55,6 +66,7 @@ export async function backupView(context: AxisContext): Promise<AxisViewPage> {
     element: h("div", { class: "page" },
       h("div", { "data-testid": "backup-progress" }, () => progressLine(view.running.val)),
       h("div", { "data-testid": "backup-result" }, messageView(view.result)),
+      h("div", null, () => (view.notes.val.length ? h("ul", { class: "muted", "data-testid": "backup-notes" }, view.notes.val.map((note) => h("li", null, note))) : null)),
       h("div", { class: "grid cols-2" },
         h("section", { class: "panel" }, h("h2", null, "Drive ⇄ project"),
           h("div", { class: "panel-body grid", style: { gap: "8px" } },
@@ -62,6 +74,7 @@ export async function backupView(context: AxisContext): Promise<AxisViewPage> {
             h("div", { class: "toolbar" },
               button("Back up drive into project", () => run(view, "Reading the drive", saved.length, backupToProject(view, saved)), "backup-to-project", true),
               button("Restore project to drive…", () => restoreFromProject(view), "restore-from-project")),
+            h("div", null, () => keptLine(view, button)),
             h("div", { class: "toolbar" }, button("Store parameters to flash", () => run(view, "Storing to flash", 1, storeToFlash(view)), "store-flash"),
               h("span", { class: "muted" }, "0x1010,1 = 'save': the drive keeps its values after a power cycle")))),
         h("section", { class: "panel" }, h("h2", null, "Drive files ⇄ this PC"),
@@ -104,6 +117,7 @@ async function run(view: BackupView, label: string, total: number, work: Work): 
   const controller = new AbortController();
   view.running.val = { label, controller, progress };
   view.result.val = null;
+  view.notes.val = [];
   try {
     const outcome = await work(controller.signal, (done, extra, newTotal) => {
       progress.val = { done, total: newTotal ?? progress.rawVal.total, extra: extra ?? "" };
@@ -111,6 +125,7 @@ async function run(view: BackupView, label: string, total: number, work: Work): 
     // A server job may have ended before Cancel reached it: then it says it was not cancelled.
     const cancelled = outcome.cancelled ?? controller.signal.aborted;
     view.result.val = { text: cancelled ? `${label} cancelled. ${outcome.text}` : outcome.text, tone: cancelled || outcome.warning ? "warn" : "ok" };
+    view.notes.val = outcome.notes ?? [];
   } catch (error) {
     view.result.val = { text: `${label}: ${errorText(error)}`, tone: "error" };
   } finally {
@@ -118,65 +133,132 @@ async function run(view: BackupView, label: string, total: number, work: Work): 
   }
 }
 
-/** Read the saved entries from the drive in chunks, then store them in the project (what it cannot hold is listed). */
+/**
+ * Read the saved entries from the drive in chunks, show what storing them changes in the project and ask, then store
+ * them keeping the project's previous revision restorable; what the project cannot hold is left out and listed.
+ */
 function backupToProject(view: BackupView, saved: Entry[]): Work {
   const { project, axis } = view.context;
   return async (signal, step) => {
-    const values: Record<string, number | string> = {};
-    const failed: string[] = [];
-    const refused: string[] = [];
-    for (let start = 0; start < saved.length && !signal.aborted; start += CHUNK) {
-      const chunk = saved.slice(start, start + CHUNK);
-      const read = await driveApi.readMany(view.bus, view.node, chunk.map((e) => [e.object.index, e.variable.subindex]), signal);
-      for (const [position, value] of read.entries()) {
-        const label = projectAddress(value.index, value.subindex);
-        const refusal = value.error ? null : unstorableReason(chunk[position].variable, value.raw);
-        if (value.error || value.raw === null) failed.push(`${label}: ${value.error}`);
-        else if (refusal) refused.push(`${label}: ${refusal}`);
-        else values[label] = value.raw;
-      }
-      step(Math.min(saved.length, start + CHUNK));
-    }
+    const read = await readSaved(view, saved, signal, step);
     if (signal.aborted) return { text: "Nothing was stored in the project.", warning: true };
-    const answer = await setParametersSkipping(project.name, axis.name, values);
-    refused.push(...answer.skipped);
-    const stored = Object.keys(values).length - answer.skipped.length;
+    const current = (await projects.parameters(project.name, axis.name)).parameters;
+    const changes = projectChanges(saved, read.values, current);
+    if (!(await confirmBackup(view, read, changes))) return { text: "Nothing was stored: the project is unchanged.", warning: false, cancelled: true };
+    const answer = await setParametersSkipping(project.name, axis.name, read.values, true);
+    const refused = [...read.refused, ...answer.skipped];
+    const stored = Object.keys(read.values).length - answer.skipped.length;
+    await loadKept(view);
+    const left = refused.length ? ` ${refused.length} drive values the project cannot hold were left out (listed below).` : "";
+    const failed = read.failed.length ? ` ${read.failed.length} could not be read (listed below).` : "";
     return {
-      text: `${stored} values of node ${view.node} stored in project ${project.name} (${answer.parameters.length} changed).`
-        + (refused.length ? ` ${refused.length} the project cannot hold: ${refused.slice(0, 3).join("; ")}.` : "")
-        + (failed.length ? ` ${failed.length} could not be read: ${failed.slice(0, 3).join("; ")}.` : ""),
-      warning: refused.length > 0 || failed.length > 0,
+      text: `${stored} values of node ${view.node} stored in project ${project.name}: ${changes.length} changed.${left}${failed}`
+        + (view.kept.rawVal ? ` The previous project revision ${view.kept.rawVal.revision} is kept: restore it below.` : ""),
+      warning: read.failed.length > 0,
+      notes: [...refused.map((text) => `left out: ${text}`), ...read.failed.map((text) => `not read: ${text}`)],
     };
   };
 }
 
-/** Write every value the project files set into the drive, one by one (refusals are counted and listed). */
-async function restoreFromProject(view: BackupView): Promise<void> {
-  const { project, axis, dictionary } = view.context;
-  const rows = (await projects.parameters(project.name, axis.name)).parameters.filter((row) => row.file !== null && row.value !== null);
-  const byKey = new Map(entries(dictionary).map((entry) => [entry.key, entry]));
-  const writes = rows.flatMap((row) => {
-    const entry = byKey.get(`${row.index}.${row.subindex}`);
-    return entry && isWritable(entry.variable.access) ? [{ row, entry }] : [];
-  });
-  if (!(await confirmAction("Restore project to drive", `Write ${writes.length} project values into node ${view.node} on ${view.bus}? The drive's current values are overwritten.`, "Write to drive", true))) return;
-  await run(view, "Writing the drive", writes.length, async (signal, step) => {
-    const failed: string[] = [];
-    let written = 0;
-    for (const [position, { row, entry }] of writes.entries()) {
-      if (signal.aborted) break;
-      try {
-        await driveApi.write(view.bus, view.node, entry.object.index, entry.variable.subindex, row.value as number | string);
-        written++;
-      } catch (error) {
-        failed.push(`${projectAddress(row.index, row.subindex)}: ${errorText(error)}`);
-      }
-      step(position + 1, failed.length ? `${failed.length} refused` : "");
+interface SavedValues {
+  values: Record<string, number | string>;
+  failed: string[];
+  refused: string[];
+}
+
+async function readSaved(view: BackupView, saved: Entry[], signal: AbortSignal, step: Step): Promise<SavedValues> {
+  const result: SavedValues = { values: {}, failed: [], refused: [] };
+  for (let start = 0; start < saved.length && !signal.aborted; start += CHUNK) {
+    const chunk = saved.slice(start, start + CHUNK);
+    const read = await driveApi.readMany(view.bus, view.node, chunk.map((e) => [e.object.index, e.variable.subindex]), signal);
+    for (const [position, value] of read.entries()) {
+      const label = projectAddress(value.index, value.subindex);
+      const refusal = value.error ? null : unstorableReason(chunk[position].variable, value.raw);
+      if (value.error || value.raw === null) result.failed.push(`${label}: ${value.error}`);
+      else if (refusal) result.refused.push(`${label}: ${refusal}`);
+      else result.values[label] = value.raw;
     }
-    return {
-      text: `${written} values written to node ${view.node}.${failed.length ? ` ${failed.length} refused: ${failed.slice(0, 3).join("; ")}.` : ""} Store to flash to keep them after a power cycle.`,
-      warning: failed.length > 0,
-    };
+    step(Math.min(saved.length, start + CHUNK));
+  }
+  return result;
+}
+
+/** The project values a backup replaces (project value → drive value), in dictionary order. */
+export function projectChanges(saved: Entry[], values: Record<string, number | string>, current: ProjectParameter[]): Change[] {
+  const rows = new Map(current.map((row) => [entryKey(row.index, row.subindex), row]));
+  const text = (entry: Entry, raw: Scalar) => `${formatValue(entry.variable, raw)} ${entry.variable.unit}`.trim();
+  return saved.flatMap((entry) => {
+    const raw = values[projectAddress(entry.object.index, entry.variable.subindex)];
+    const row = rows.get(entry.key);
+    if (raw === undefined || (row && sameValue(row.value, raw))) return [];
+    const old = row && row.value !== null ? text(entry, row.value) : "not set";
+    return [{ address: projectAddress(entry.object.index, entry.variable.subindex), name: entry.variable.name, old, new: text(entry, raw) }];
+  });
+}
+
+function confirmBackup(view: BackupView, read: SavedValues, changes: Change[]): Promise<boolean> {
+  const count = Object.keys(read.values).length;
+  return confirmChanges({
+    title: "Back up drive into project", confirm: `Store ${count} values in the project`, changes, folded: true,
+    text: `Store the ${count} values read from node ${view.node} in project ${view.context.project.name}? ${changes.length} project values change (project → drive), ${count - changes.length} are the same already.`,
+    notes: [
+      "The project as it is now is kept as a revision: you can restore it afterwards.",
+      ...(read.refused.length ? [`${read.refused.length} drive values the project cannot hold are left out; they are listed afterwards.`] : []),
+      ...(read.failed.length ? [`${read.failed.length} entries the drive did not answer are left out; they are listed afterwards.`] : []),
+    ],
+  });
+}
+
+async function loadKept(view: BackupView): Promise<void> {
+  try {
+    view.kept.val = (await projects.revisions(view.context.project.name))[0] ?? null;
+  } catch {
+    view.kept.val = null;
+  }
+}
+
+type Button = (label: string, action: () => Promise<void>, testid: string, primary?: boolean) => HTMLElement;
+
+function keptLine(view: BackupView, button: Button): HTMLElement | null {
+  const kept = view.kept.val;
+  if (!kept) return null;
+  const when = new Date(kept.saved_at * 1000).toLocaleString();
+  return h("div", { class: "toolbar" },
+    button("Restore previous project revision…", () => restoreKept(view, kept), "restore-revision"),
+    h("span", { class: "muted", "data-testid": "kept-revision" }, `revision ${kept.revision}, replaced ${when} (${kept.reason})`));
+}
+
+async function restoreKept(view: BackupView, kept: KeptRevision): Promise<void> {
+  const name = view.context.project.name;
+  if (!(await confirmAction("Restore previous project revision", `Make project ${name} what it was before: revision ${kept.revision} (replaced by: ${kept.reason})? The project as it is now is kept as a revision in turn.`, "Restore revision"))) return;
+  await run(view, "Restoring the project", 1, async (_signal, step) => {
+    const restored = await projects.restoreRevision(name, kept.revision);
+    step(1);
+    await loadKept(view);
+    return { text: `Project ${name} restored to revision ${restored.revision}.`, warning: false };
+  });
+}
+
+/**
+ * Restore the values the project sets to the drive as its own files (DRIVEPAR.TXT, USER_PAR.TXT), each one server
+ * job — validated, written, verified and stored, the path of `servostudio restore` (issue #14 point 5: one REST
+ * write per value took 5.7 s for 370 values; the job takes about a second).
+ */
+async function restoreFromProject(view: BackupView): Promise<void> {
+  const { project, axis } = view.context;
+  const { files, left } = objectFiles((await projects.parameters(project.name, axis.name)).parameters);
+  const names = [...files.keys()];
+  if (names.length === 0) return void (view.result.val = { text: `Project ${project.name} sets no value of axis ${axis.name}.`, tone: "warn" });
+  if (!(await confirmAction("Restore project to drive", `Write the project's ${names.join(" and ")} of axis ${axis.name} into node ${view.node} on ${view.bus} and store them to flash? They are validated first; the drive's current values are overwritten.`, "Write to drive", true))) return;
+  await run(view, "Writing the drive", 1, async (signal, step) => {
+    const done: string[] = [];
+    for (const [name, text] of files) {
+      const outcome = await restoreJob(view, name, text, signal, step);
+      done.push(outcome.text);
+      if (outcome.cancelled) return { ...outcome, text: done.join(" ") };
+    }
+    const note = left.length ? ` ${left.length} values no file can carry were left out: ${left.slice(0, 3).join("; ")}.` : "";
+    return { text: done.join(" ") + note, warning: left.length > 0, cancelled: false };
   });
 }
 
@@ -213,16 +295,18 @@ async function restoreFile(view: BackupView, name: string): Promise<void> {
   if (!file) return;
   if (!(await confirmAction(`Restore ${name}`, `Send ${file.name} to node ${view.node} as ${name}? It is validated first, then written, verified and stored to flash.`, "Restore", true))) return;
   const text = await file.text();
-  // Its progress comes as events and Cancel stops it on the server at the next object.
-  await run(view, `Restoring ${name}`, 1, async (signal, step) => {
-    const job = await runJob<RestoreResult>(view.context.page.app.live,
-      () => request<JobInfo<RestoreResult>>("PUT", `${driveApi.fileUrl(view.bus, view.node, name)}?job=true`, new Blob([text], { type: "text/plain" })),
-      (event) => step(Number(event.done) || 0, String(event.file ?? ""), Number(event.total) || 1), signal);
-    const answer = job.result?.[String(view.node)]?.[0];
-    if (!answer) throw new Error(job.error ?? `the restore job ended ${job.state}`);
-    const counts = Object.entries(answer.counts).map(([status, count]) => `${count} ${status}`).join(", ");
-    if (answer.cancelled) return { text: `${answer.error ?? ""} (${counts}).`, warning: true, cancelled: true };
-    if (!answer.ok) throw new Error(`${answer.error ?? "not all objects verified"} (${counts}) ${answer.objects.slice(0, 3).map((o) => `${o.label}: ${o.error}`).join("; ")}`);
-    return { text: `${name} restored to node ${view.node}: ${counts}.`, warning: false, cancelled: false };
-  });
+  await run(view, `Restoring ${name}`, 1, (signal, step) => restoreJob(view, name, text, signal, step));
+}
+
+/** One drive file restored by a server job; its progress comes as events and Cancel stops it at the next object. */
+async function restoreJob(view: BackupView, name: string, text: string, signal: AbortSignal, step: Step): Promise<Outcome> {
+  const job = await runJob<RestoreResult>(view.context.page.app.live,
+    () => request<JobInfo<RestoreResult>>("PUT", `${driveApi.fileUrl(view.bus, view.node, name)}?job=true`, new Blob([text], { type: "text/plain" })),
+    (event) => step(Number(event.done) || 0, String(event.file ?? ""), Number(event.total) || 1), signal);
+  const answer = job.result?.[String(view.node)]?.[0];
+  if (!answer) throw new Error(job.error ?? `the restore job ended ${job.state}`);
+  const counts = Object.entries(answer.counts).map(([status, count]) => `${count} ${status}`).join(", ");
+  if (answer.cancelled) return { text: `${answer.error ?? ""} (${counts}).`, warning: true, cancelled: true };
+  if (!answer.ok) throw new Error(`${answer.error ?? "not all objects verified"} (${counts}) ${answer.objects.slice(0, 3).map((o) => `${o.label}: ${o.error}`).join("; ")}`);
+  return { text: `${name} restored to node ${view.node}: ${counts}.`, warning: false, cancelled: false };
 }

@@ -129,9 +129,10 @@ function scan(view: BusView, bus: BusInfo): Promise<void> {
   view.scanning.val = new Set([...view.scanning.rawVal, bus.id]);
   return guard(view, async () => {
     try {
-      const found = await driveApi.scan(bus.id);
+      const { nodes: found, hint } = await driveApi.scan(bus.id);
       view.scanned.val = new Map([...view.scanned.rawVal, [bus.id, found]]);
-      toast(`${found.length} node${found.length === 1 ? "" : "s"} found on ${bus.id}`, "ok");
+      if (found.length === 0) view.message.val = { tone: "warn", text: `No node answered on ${bus.id}. ${hint ?? ""}`.trim(), testid: "scan-hint" };
+      else toast(`${found.length} node${found.length === 1 ? "" : "s"} found on ${bus.id}`, "ok");
     } finally {
       view.scanning.val = new Set([...view.scanning.rawVal].filter((id) => id !== bus.id));
       view.buses.val = await driveApi.buses();

@@ -6,10 +6,13 @@ import { loader, type Loaded } from "../lib/async";
 import { STEPS, stepKeys, stepStatus, type Step, type StepStatus } from "../lib/commissioning";
 import { h, Scope, state, type State } from "../lib/dom";
 import { formatHex } from "../lib/numbers";
-import { buildPath } from "../lib/router";
+import { buildPath, type AxisView } from "../lib/router";
 import type { AxisContext, AxisViewPage } from "./axis";
 
 const TICKS_KEY = "servostudio.commissioning";
+
+/** The procedure pages a step links to (the current loop page also has the I²t protection). */
+const PROCEDURE_PAGES = { "current-loop": "Current loop", phasing: "Phasing", tuning: "Auto-tuning" };
 
 /** Step key → when the user ticked it (ISO time). */
 type Ticks = Record<string, string>;
@@ -105,7 +108,7 @@ function stepItem(view: ChecklistView, step: Step, position: number, status: Ste
 function stepLink(view: ChecklistView, step: Step): Node {
   const { project, dictionary } = view.context;
   const axis = view.axis.val;
-  const page = (target: "dashboard" | "backup" | "parameters", label: string, query: Record<string, string> = {}) =>
+  const page = (target: AxisView, label: string, query: Record<string, string> = {}) =>
     h("a", { class: "button", href: buildPath({ page: "axis", project: project.name, axis: axis.name, view: target }, query) }, label);
   const firstObject = step.objects.map((o) => dictionary.objects.find((d) => d.index === o.index)).find(Boolean);
   const parameters = firstObject ? page("parameters", "Parameters", { group: firstObject.group }) : null;
@@ -118,6 +121,10 @@ function stepLink(view: ChecklistView, step: Step): Node {
       return h("span", { class: "toolbar" }, page("dashboard", "Dashboard"), parameters);
     case "backup":
       return h("span", { class: "toolbar" }, page("backup", "Backup / store"));
+    case "current-loop":
+    case "phasing":
+    case "tuning":
+      return h("span", { class: "toolbar" }, page(step.page, PROCEDURE_PAGES[step.page]), parameters);
     default:
       return parameters ?? h("span", { class: "muted" }, "—");
   }

@@ -1,6 +1,6 @@
 /**
  * Axis dashboard: device control (CiA 402 state, allowed transitions, mode of operation, NMT), faults and
- * warnings, the profile-velocity quick test, measurements, the status word bit by bit and the digital I/O — each a
+ * warnings, the quick test (profile velocity, hold-to-run jog, moves and homing), measurements, the status word bit by bit and the digital I/O — each a
  * component of `components/dashboard/` bound to the page's `DashboardModel` (live values from the server's terminal
  * socket: it samples, this page renders).
  */
@@ -12,10 +12,13 @@ import { digitalIo } from "../components/dashboard/io";
 import { measurementsPanel } from "../components/dashboard/measurements";
 import { DashboardModel } from "../components/dashboard/model";
 import { dashboardNotice } from "../components/dashboard/notice";
+import { phasingNotice } from "../components/dashboard/phasing-notice";
 import { quickTest } from "../components/dashboard/quick-test";
+import { QuickMotion } from "../components/motion/model";
 import { statusWordPanel } from "../components/dashboard/status-word";
 import { heldByMe } from "../client/control";
 import { dashboardSignals } from "../lib/dashboard-objects";
+import { buildPath } from "../lib/router";
 import { Scope, h } from "../lib/dom";
 import type { Entry } from "../lib/od";
 import { formatValue } from "../lib/values";
@@ -24,16 +27,24 @@ import type { AxisContext, AxisViewPage } from "./axis";
 export async function dashboardView(context: AxisContext): Promise<AxisViewPage> {
   const scope = new Scope();
   const model = scope.run(() => new DashboardModel(context, dashboardSignals(context.dictionary), scope));
-  const element = scope.run(() => layout(model));
+  const motion = scope.run(() => quickMotion(context, scope));
+  const element = scope.run(() => layout(model, context, motion));
   void model.start();
+  void motion.load();
   return { element, dispose: () => scope.dispose() };
 }
 
-function layout(model: DashboardModel): HTMLElement {
+function quickMotion(context: AxisContext, scope: Scope): QuickMotion {
+  const { axis, page } = context;
+  return new QuickMotion({ bus: axis.bus, node: axis.node_id, device: axis.device, live: page.app.live, scope });
+}
+
+function layout(model: DashboardModel, context: AxisContext, motion: QuickMotion): HTMLElement {
   const columns = (template: string, ...children: (HTMLElement | null)[]) =>
     h("div", { class: "grid", style: { gridTemplateColumns: template } }, children);
   return h("div", { class: "page" },
     dashboardNotice({ message: model.message, onOpenBus: (bus) => void model.openBus(bus) }),
+    motorPhasingNotice(model, context),
     columns("minmax(0, 1.35fr) minmax(0, 1fr)",
       control(model),
       h("div", { class: "grid", style: { alignContent: "start" } },
@@ -43,7 +54,7 @@ function layout(model: DashboardModel): HTMLElement {
           onRequest: () => void model.request(), onTakeOver: () => void model.takeOver(),
         }),
         faultsPanel({ report: model.faults, onReset: () => void model.runCommand("fault_reset") }),
-        quickTestPanel(model))),
+        quickTestPanel(model, motion))),
     measurementsPanel({ entries: model.signals.measurements, cell: (entry) => model.cell(entry).val, address: (entry) => model.key(entry) }),
     columns("minmax(0, 1fr) minmax(0, 1fr)",
       statusWordPanel({
@@ -75,10 +86,15 @@ function control(model: DashboardModel): HTMLElement {
 }
 
 /** Profile velocity quick test, when the dictionary has a target velocity and a mode of operation. */
-function quickTestPanel(model: DashboardModel): HTMLElement | null {
+function quickTestPanel(model: DashboardModel, motion: QuickMotion): HTMLElement | null {
   const { targetVelocity, acceleration, deceleration, mode } = model.signals;
   if (!targetVelocity || !mode) return null;
+  const armed = () => heldByMe(model.control.val);
   return quickTest({
+    motion: {
+      model: motion, armed, busy: model.busy, heldElsewhere: () => Boolean(model.control.val?.holder) && !armed(),
+      onArm: () => void model.arm(), onRelease: () => void model.release(),
+    },
     acceleration, deceleration, target: targetVelocity,
     value: (entry) => model.quickValue(entry),
     onRun: (values) => void model.runQuickTest(values),
@@ -90,4 +106,16 @@ function quickTestPanel(model: DashboardModel): HTMLElement | null {
 function liveWord(model: DashboardModel, entry: Entry): number | null {
   const raw = model.cell(entry).val.value?.raw;
   return typeof raw === "number" ? raw : null;
+}
+
+/** Warning bit 30 (motor phasing needed) with its one-click remedy. */
+function motorPhasingNotice(model: DashboardModel, context: AxisContext): HTMLElement {
+  const { project, axis } = context;
+  return phasingNotice({
+    live: context.page.app.live,
+    where: { bus: axis.bus, node: axis.node_id, project: project.name, axis: axis.name },
+    faults: model.faults,
+    armed: () => heldByMe(model.control.val),
+    phasingHref: buildPath({ page: "axis", project: project.name, axis: axis.name, view: "phasing" }),
+  });
 }

@@ -14,7 +14,8 @@ import { ALL_GROUPS, APPLICATION_GROUPS, filterEntries, rowsOf, type Row } from 
 import { ParameterStore, type DriveCell } from "../components/parameters/store";
 import { ParameterTable } from "../components/parameters/table";
 import { parameterToolbar } from "../components/parameters/toolbar";
-import { WriteTargets } from "../components/parameters/write";
+import { LiveValues, type Watcher } from "../components/parameters/live";
+import { WriteTargets, type Targets } from "../components/parameters/write";
 import { errorText, toast } from "../components/ui";
 import { Scope, batch, derive, h, state, untrack, type State } from "../lib/dom";
 import { entries as allEntries, isReadable, type Dictionary, type Entry, type Scalar } from "../lib/od";
@@ -29,6 +30,8 @@ export interface ParameterSources {
     online(): boolean;
     read(entries: Entry[], signal: AbortSignal): Promise<Map<string, DriveCell>>;
     write(entry: Entry, raw: number | string): Promise<Scalar>;
+    /** Follow these entries' drive values (the server samples them); an empty list stops. */
+    watch?: Watcher;
   };
   project: null | {
     load(): Promise<ProjectParameter[]>;
@@ -52,7 +55,8 @@ export class ParameterEditor {
   private readonly byKey = new Map<string, Entry>();
   private readonly index: Searchable[];
   private readonly store: ParameterStore;
-  private readonly targets: WriteTargets;
+  private readonly targets = new WriteTargets();
+  private readonly live: LiveValues;
   private readonly applicationGroups: Set<string>;
   private readonly text: State<string>;
   private readonly group: State<string>;
@@ -80,13 +84,13 @@ export class ParameterEditor {
     this.applicationGroups = new Set(sources.application?.groups ?? []);
     const drive = sources.drive;
     this.store = new ParameterStore(Boolean(drive?.online()), drive ? (list, signal) => drive.read(list, signal) : null);
-    this.targets = new WriteTargets(this.store, sources.drive !== null, sources.project !== null);
+    this.live = new LiveValues(this.store, drive?.watch ?? null);
     this.text = state(location.query.q ?? "");
     this.group = state(this.initialGroup(location.query.group));
     const view = this.scope.run(() => derive(() => this.filter()));
     this.shown = this.scope.run(() => derive(() => view.val.shown));
     this.rows = this.scope.run(() => derive(() => view.val.rows));
-    this.bulk = this.scope.run(() => new BulkActions(this.store, sources, this.shown));
+    this.bulk = this.scope.run(() => new BulkActions(this.store, sources, this.shown, this.entryList));
     this.table = new ParameterTable({
       store: this.store, rows: this.rows, selected: this.selected,
       hasDrive: sources.drive !== null, hasProject: sources.project !== null,
@@ -114,6 +118,7 @@ export class ParameterEditor {
 
   dispose(): void {
     this.abort.abort();
+    this.live.stop();
     this.bulk.running.rawVal?.controller.abort();
     clearTimeout(this.readTimer);
     this.scope.dispose();
@@ -214,7 +219,7 @@ export class ParameterEditor {
     return detailPane({
       store: this.store, targets: this.targets, selected: this.selected, shown: this.shown, entries: this.entryList,
       hasDrive: this.sources.drive !== null, hasProject: this.sources.project !== null,
-      write: (entry, raw) => this.writeValue(entry, raw),
+      write: (entry, raw, targets) => this.writeValue(entry, raw, targets),
       leave: () => this.table.focus(),
     });
   }
@@ -230,7 +235,12 @@ export class ParameterEditor {
       });
     });
     this.scope.effect(() => {
-      if (this.store.online.val) untrack(() => this.scheduleRead(this.table.visible));
+      const online = this.store.online.val;
+      untrack(() => (online ? this.scheduleRead(this.table.visible) : this.watchLive()));
+    });
+    this.scope.effect(() => {
+      const selected = this.selected.val;
+      untrack(() => this.watchLive(selected));
     });
   }
 
@@ -272,6 +282,7 @@ export class ParameterEditor {
 
   /** Read the drive values of rows that came into view and have none yet, batched and debounced. */
   private scheduleRead(rows: Row[]): void {
+    this.watchLive();
     if (!this.sources.drive || !this.store.online.rawVal) return;
     for (const row of rows) {
       if (row.kind === "entry" && isReadable(row.entry.variable.access) && this.store.driveCell(row.entry.key).rawVal === undefined) {
@@ -286,9 +297,14 @@ export class ParameterEditor {
     }, READ_DEBOUNCE_MS);
   }
 
-  /** Write one value to the chosen targets (the server validates); the names of the targets written. */
-  private async writeValue(entry: Entry, raw: number | string): Promise<string[]> {
-    const targets = this.targets.resolve();
+  /** The live entries in view and the selected one follow the drive (`LiveValues`). */
+  private watchLive(selected: Entry | null = this.selected.rawVal): void {
+    const inView = this.table.visible.flatMap((row) => (row.kind === "entry" ? [row.entry] : []));
+    this.live.show(inView, selected);
+  }
+
+  /** Write one value to the targets the user chose (the server validates); the names of the targets written. */
+  private async writeValue(entry: Entry, raw: number | string, targets: Targets): Promise<string[]> {
     const done: string[] = [];
     if (targets.drive && this.sources.drive) {
       this.store.driveCell(entry.key).val = { raw: await this.sources.drive.write(entry, raw) };

@@ -2,7 +2,7 @@
 
 import type { App, Page, PageContext } from "../app";
 import { listDictionaries, projects, type AxisConfig, type BusConfig, type Project } from "../client/api";
-import { driveApi, serverBus, type BusInfo } from "../client/drives";
+import { busMatches, driveApi, serverBus, type BusInfo, type BusMatch } from "../client/drives";
 import { axisStateText } from "../client/live";
 import { commissionPanel } from "../components/commissionjob";
 import { axisDialog, busesDialog, renameDialog } from "../components/project-dialogs";
@@ -136,9 +136,20 @@ function busesTable(view: ProjectView): HTMLElement {
 /** The server bus a project bus maps to, or Connect when the server has not opened it. */
 function serverCell(view: ProjectView, bus: BusConfig): Node {
   const open = view.serverBuses.val.find((candidate) => candidate.id === serverBus(bus.name));
-  if (open) return h("span", { class: open.connected ? "ok-text" : "error-text" }, `${open.connected ? "connected" : "disconnected"} as ${open.id}`);
+  if (open) {
+    return h("span", { class: "toolbar" },
+      h("span", { class: open.connected ? "ok-text" : "error-text" }, `${open.connected ? "connected" : "disconnected"} as ${open.id}`),
+      busMatchNote(busMatches.val.get(bus.name), open));
+  }
   return h("span", { class: "toolbar" }, h("span", { class: "muted" }, "not open"),
     h("button", { class: "small primary", "data-testid": `open-bus-${bus.name}`, onclick: () => void openBus(view, bus) }, "Connect"));
+}
+
+/** How the server matched the project bus to its open bus, when not simply by the same name and spec. */
+function busMatchNote(match: BusMatch | undefined, open: BusInfo): Node | null {
+  if (match?.by === "spec") return h("span", { class: "muted", "data-testid": "bus-match-note" }, `same spec, opened on the server as ${open.id}`);
+  if (match?.by === "name_only") return h("span", { class: "warn-text", "data-testid": "bus-match-note" }, `the server's ${open.id} has another spec: ${open.spec}`);
+  return null;
 }
 
 async function openBus(view: ProjectView, bus: BusConfig): Promise<void> {

@@ -12,6 +12,7 @@ from tests.sim.recorder_peer import REV, Probe
 from tests.support.embedded_sim import open_sim
 
 from servostudio.drive.access import Drive
+from servostudio.drive.sdo import SdoNodeRestarted
 from servostudio.services.bus import BusConnection, ConnectionManager
 from servostudio.services.cancel import Cancellation
 from servostudio.services.scope import Capture, CaptureDefinition, capture, identity_of
@@ -111,6 +112,21 @@ def bench() -> Iterator[ScopeBench]:
     manager = ConnectionManager()
     open_sim(manager, "sim:1,2:cd1k")
     try:
-        yield ScopeBench(manager.get("sim"))
+        scope_bench = ScopeBench(manager.get("sim"))
+        for node in (1, 2):
+            _until_booted(scope_bench.drive(node))
+        yield scope_bench
     finally:
         manager.close_all()
+
+
+def _until_booted(drive: Drive) -> None:
+    """A loaded host may run a simulated node's boot-up after the bus opened: a request sent before it is lost
+    (``SdoNodeRestarted``), so the tests start once every node has answered."""
+    for _attempt in range(3):
+        try:
+            drive.read("0x1000")
+            return
+        except SdoNodeRestarted:
+            continue
+    drive.read("0x1000")

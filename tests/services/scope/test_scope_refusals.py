@@ -93,10 +93,10 @@ def test_a_trigger_on_a_channel_uses_the_channel_and_one_elsewhere_a_pointer(ben
     assert elsewhere.trigger_source == 0x60FF0020
 
 
-def test_a_drive_without_recorder_is_refused_for_now(bench):
+def test_the_recorder_of_a_drive_without_one_is_refused(bench):
     drive = bench.drive(2)  # a CD1-k
-    with pytest.raises(NoRecorder, match=r"node 2 \(cd1k\): no recorder: TPDO capture comes later"):
-        check(drive, CaptureDefinition(("0x6041",)))
+    with pytest.raises(NoRecorder, match=r"node 2 \(cd1k\): no recorder; its captures go through TPDOs"):
+        check(drive, CaptureDefinition(("0x6041",), source="recorder"))
 
 
 @pytest.mark.parametrize(

@@ -7,6 +7,7 @@ from dataclasses import replace
 import pytest
 
 from servostudio.sim.drive import gains
+from servostudio.sim.drive.commissioning import COMMISSIONING_BANDWIDTH_HZ
 from servostudio.sim.plant import Plant
 
 REV = 4096
@@ -20,7 +21,7 @@ def test_commissioned_drive_holds_the_plants_true_values(harness):
     assert h.read(0x6410, 12) == round(plant.motor_inertia * 1e6)
     assert h.read(0x6075) == round(plant.stall_current * 1000)
     expected = gains.tuned_gains(
-        plant.total_inertia, plant.torque_constant, 75.0, viscous_friction=plant.viscous_friction
+        plant.total_inertia, plant.torque_constant, COMMISSIONING_BANDWIDTH_HZ, viscous_friction=plant.viscous_friction
     )
     assert h.read(0x60F9, 2) == expected.kpv
     assert h.read(0x60FB, 2) == expected.kpp

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 from typing import Annotated
 
 from fastapi import APIRouter, Body, Response, status
@@ -21,6 +22,8 @@ router = APIRouter(tags=["backup"])
 #: A drive file as uploaded: its bytes (8-bit text, read as Latin-1, so any byte is accepted); an empty body is an
 #: empty file, which is valid (it sets nothing).
 DRIVE_FILE_BYTES = 1 * MIB  # a full SEQUENCE.TXT (128 sequences) is about 100 kB
+BACKUP_RESULT_HEADER = "X-Backup-Result"
+BACKUP_RESULT = "the backup's result as JSON: {node, file, kind, objects, skipped: [{object, reason}], seconds}"
 FileBytes = Annotated[bytes, Body(media_type="text/plain", description="the drive file (8-bit text, Latin-1)")]
 
 
@@ -84,11 +87,15 @@ def get_job(job_id: str, jobs: Jobs) -> dict:
     "/buses/{bus}/nodes/{node}/files/{name}",
     response_class=PlainTextResponse,
     summary="Back up one file of one drive and download it (DRIVEPAR.TXT, USER_PAR.TXT, SEQUENCE.TXT)",
-    responses=error_responses(*DRIVE_ERRORS),
+    responses={
+        **error_responses(*DRIVE_ERRORS),
+        200: {"headers": {BACKUP_RESULT_HEADER: {"description": BACKUP_RESULT, "schema": {"type": "string"}}}},
+    },
     dependencies=[Requires(Level.MAINTENANCE)],
 )
-def download_file(name: str, drive: NodeDrive) -> str:
-    return transfers.download(drive, transfers.file_kind(name))
+def download_file(name: str, drive: NodeDrive) -> PlainTextResponse:
+    text, result = transfers.download(drive, transfers.file_kind(name))
+    return PlainTextResponse(text, headers={BACKUP_RESULT_HEADER: json.dumps(result, separators=(",", ":"))})
 
 
 @router.put(

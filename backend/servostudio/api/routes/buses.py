@@ -7,7 +7,17 @@ from fastapi import APIRouter, Response, status
 
 from servostudio.api.deps import Connections, OpenBus
 from servostudio.api.errors import error_responses
-from servostudio.api.routes.comm_models import BusOpen, BusStatus, NmtRequest, NodeIdentity
+from servostudio.api.routes.comm_models import (
+    BusMatchModel,
+    BusMatchRequest,
+    BusOpen,
+    BusStatus,
+    NmtRequest,
+    NodeIdentity,
+    OpenedBus,
+    ShareModel,
+    ShareRequest,
+)
 from servostudio.api.security import Requires
 from servostudio.errors import ErrorKind
 from servostudio.services.scan import empty_scan_hint, scan
@@ -35,13 +45,28 @@ def list_buses(manager: Connections) -> list[dict]:
 
 @router.post(
     "",
-    response_model=BusStatus,
+    response_model=OpenedBus,
     status_code=status.HTTP_201_CREATED,
-    summary="Open a bus from a spec string (an existing bus with the same spec is returned)",
+    summary="Open a bus from a spec string: 201 opened; 200 with existing: true when that spec is open already "
+    "(without id or under the same id); 409 naming the open bus when another id is asked for",
+    responses={200: {"model": OpenedBus, "description": "the spec was open already: that bus, existing: true"}},
     dependencies=[Requires(Level.MAINTENANCE)],
 )
-def open_bus(request: BusOpen, manager: Connections) -> dict:
-    return manager.open(request.spec, request.id).status()
+def open_bus(request: BusOpen, manager: Connections, response: Response) -> dict:
+    connection, existing = manager.opened(request.spec, request.id)
+    if existing:
+        response.status_code = status.HTTP_200_OK
+    return {**connection.status(), "existing": existing}
+
+
+@router.post(
+    "/match",
+    response_model=list[BusMatchModel],
+    summary="Which open bus each project bus is: by spec (any spelling) first, else by name",
+    dependencies=[Requires(Level.OPERATOR)],
+)
+def match_buses(request: BusMatchRequest, manager: Connections) -> list[dict]:
+    return [manager.match(bus.name, bus.spec).as_dict() for bus in request.buses]
 
 
 @router.get("/{bus}", response_model=BusStatus, summary="One bus", dependencies=[Requires(Level.OPERATOR)])
@@ -79,3 +104,36 @@ def scan_bus(connection: OpenBus, response: Response) -> list[dict]:
 )
 def nmt(request: NmtRequest, connection: OpenBus) -> None:
     connection.nmt(request.command, request.node)
+
+
+@router.get(
+    "/{bus}/share",
+    response_model=ShareModel,
+    summary="The bus's socketcand endpoint for the user's own CANopen scripts (404 when not shared)",
+    dependencies=[Requires(Level.OPERATOR)],
+)
+def get_share(connection: OpenBus) -> dict:
+    return connection.shared().as_dict()
+
+
+@router.put(
+    "/{bus}/share",
+    response_model=ShareModel,
+    summary="Share the bus as a socketcand endpoint on a loopback address (python canopen / python-can beside the UI)",
+    responses=error_responses(ErrorKind.INVALID_INPUT),
+    dependencies=[Requires(Level.EXPERT)],
+)
+def put_share(request: ShareRequest, connection: OpenBus) -> dict:
+    """SDO requests of the clients are answered by the server's SDO engine in turn (one SDO client per channel);
+    their writes pass the motion guard; NMT and SYNC go on the bus, other client frames are dropped."""
+    return connection.share_on(request.host, request.port).as_dict()
+
+
+@router.delete(
+    "/{bus}/share",
+    status_code=status.HTTP_204_NO_CONTENT,
+    summary="Stop sharing the bus (its clients are disconnected)",
+    dependencies=[Requires(Level.EXPERT)],
+)
+def delete_share(connection: OpenBus) -> None:
+    connection.share_off()

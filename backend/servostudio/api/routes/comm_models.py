@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from typing import Any
+from typing import Any, Literal
 
 from pydantic import BaseModel, ConfigDict, Field
 
@@ -56,6 +56,46 @@ class BusStatus(BaseModel):
     connected: bool
     error: str | None = None
     nodes: list[NodeIdentity] = []
+
+
+class ProjectBusRef(BaseModel):
+    name: str = Field(max_length=200, description="the project's name of the bus")
+    spec: str = Field(max_length=1000, description="the project's spec of the bus (its interface)")
+
+
+class BusMatchRequest(BaseModel):
+    model_config = _example(buses=[{"name": "line1", "spec": "socketcand:127.0.0.1:29536"}])
+    buses: list[ProjectBusRef] = Field(max_length=256)
+
+
+class BusMatchModel(BaseModel):
+    name: str
+    spec: str
+    bus: str | None = Field(description="the open bus it is (null: not open)")
+    by: Literal["name", "spec", "name_only"] | None = Field(
+        description="name: same name and spec; spec: its spec is open under another name; name_only: the open bus "
+        "of that name has another spec"
+    )
+
+
+class OpenedBus(BusStatus):
+    existing: bool = Field(description="the spec was open already (answered 200, under its own name)")
+
+
+class ShareRequest(BaseModel):
+    model_config = _example(host="127.0.0.1", port=29540)
+    host: str = Field("127.0.0.1", max_length=100, description="a loopback address (127.0.0.1, ::1, localhost)")
+    port: int = Field(0, ge=0, le=65535, description="TCP port; 0: any free port (the answer names it)")
+
+
+class ShareModel(BaseModel):
+    model_config = _example(bus="sim", host="127.0.0.1", port=29540, channel="can0", clients=1, dropped=0)
+    bus: str
+    host: str
+    port: int
+    channel: str = Field(description="the socketcand channel a client opens")
+    clients: int = Field(description="clients connected now")
+    dropped: int = Field(description="client frames not put on the bus (PDOs and others; SDO and NMT pass)")
 
 
 class NmtRequest(BaseModel):
@@ -129,7 +169,11 @@ class DriveState(BaseModel):
     node: int
     state: str | None
     statusword: int
-    nmt_state: str | None = None
+    nmt_state: str | None = Field(None, description="as the node's heartbeat or boot-up said it (null: none seen)")
+    nmt_source: Literal["heartbeat", "sdo"] | None = Field(
+        None, description="heartbeat: nmt_state is the node's own; sdo: only known to answer SDO (pre-op or op)"
+    )
+    nmt_text: str = Field("", description="what is known, for display (e.g. 'PRE-OPERATIONAL or OPERATIONAL')")
 
 
 class FaultInfoModel(BaseModel):

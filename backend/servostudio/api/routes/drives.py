@@ -17,6 +17,7 @@ from servostudio.api.routes.comm_models import (
 )
 from servostudio.api.security import ObjectWriteLevel, Requires
 from servostudio.drive.control import fault_report
+from servostudio.drive.nmt import known_nmt_state
 from servostudio.errors import ErrorKind
 from servostudio.services import device_control
 from servostudio.services.terminal import read_objects
@@ -73,7 +74,10 @@ def read_many(request: ReadMany, drive: NodeDrive) -> list[dict]:
     "/state", response_model=DriveState, summary="CiA 402 state and NMT state", dependencies=[Requires(Level.OPERATOR)]
 )
 def get_state(connection: OpenBus, drive: NodeDrive) -> dict:
-    return device_control.drive_state(connection, drive)
+    """The NMT state as the node's heartbeat or boot-up said it; without one, the status word just read over SDO
+    proves it pre-operational or operational (``nmt_source: sdo``)."""
+    state = device_control.drive_state(connection, drive)
+    return {**state, **known_nmt_state(connection.nmt_state(drive.node), answered_sdo=True)}
 
 
 @router.put(
@@ -84,7 +88,8 @@ def get_state(connection: OpenBus, drive: NodeDrive) -> dict:
 )
 def put_state(request: StateRequest, connection: OpenBus, drive: NodeDrive, motion: Motion) -> dict:
     """Enabling (operation-enabled) needs the axis armed by the caller's live client (X-Servo-Client)."""
-    return device_control.change_state(connection, motion, drive, request.target)
+    state = device_control.change_state(connection, motion, drive, request.target)
+    return {**state, **known_nmt_state(connection.nmt_state(drive.node), answered_sdo=True)}
 
 
 @router.get(

@@ -1,8 +1,9 @@
 """WebSockets: ``/api/ws/events`` (bus, drive, progress and job events) and ``/api/ws/terminal`` (dialog terminal).
 
 Events are JSON objects with a ``type``: bus_state, bus_closed, scan, emcy, bootup, nmt_state, heartbeat_lost,
-heartbeat_back, drive_state, progress, job, overflow.  While a client wants ``drive_state``, the known drives'
-status words are polled slowly (``services.bus.statewatch``).  ``/api/ws/events?types=emcy,progress`` filters.
+heartbeat_back, drive_state, progress, job, control, control_request, motion, overflow.  While a client wants
+``drive_state``, the known drives' status words are polled slowly (``services.bus.statewatch``).
+``/api/ws/events?types=emcy,progress`` filters.
 
 Terminal protocol (client → server): ``{"op": "watch", "items": [{"bus", "node", "object"}…], "period_ms": 200}``
 starts continuous monitoring (``{"op": "watch", "items": []}`` stops it), ``{"op": "read", "items": […]}`` reads once,
@@ -16,6 +17,7 @@ from __future__ import annotations
 
 import asyncio
 import contextlib
+import json
 import logging
 from collections.abc import Callable
 from typing import Any, TypeVar
@@ -39,22 +41,30 @@ T = TypeVar("T")
 #: the level each client message needs, checked per message with the caller as it is then (a session that ended
 #: or a level lowered meanwhile applies at once); a write needs the object's own level too
 TERMINAL_MESSAGES: dict[str, Level] = {"read": Level.OPERATOR, "watch": Level.OPERATOR, "write": Level.MAINTENANCE}
-#: the event socket reads client messages only to notice a disconnect: none does anything, so none needs a level
-EVENT_MESSAGES: dict[str, Level] = {}
+#: the event socket's client messages: the hold-to-run keepalive of a motion the client started (a motion needs
+#: Maintenance, so its keepalive does too); anything else is read only to notice a disconnect
+EVENT_MESSAGES: dict[str, Level] = {"keepalive": Level.MAINTENANCE}
 
 
 @router.websocket("/ws/events", dependencies=[Requires(Level.OPERATOR)])
 async def events_socket(
-    socket: WebSocket, hub: Events, motion: Motion, manager: Connections, user: Caller, types: str | None = None
+    socket: WebSocket,
+    hub: Events,
+    motion: Motion,
+    manager: Connections,
+    user: Caller,
+    control: Access,
+    types: str | None = None,
 ) -> None:
     """Events as they happen. The socket is also the caller's motion client: its first message,
     ``{"type": "hello", "client": ID}``, gives the id that arming an axis and every motion request must name
     (X-Servo-Client); the axes it holds get a quick stop when the socket closes.  An event addressed to one client
-    (``"to"``: a ``control_request`` for the axis's holder) goes to that client only."""
+    (``"to"``: a ``control_request`` for the axis's holder) goes to that client only.  The client sends
+    ``{"type": "keepalive", "bus", "node"}`` while it holds a hold-to-run motion (``services.motion.hold``)."""
     await socket.accept()
     client = motion.connect(user.name)
     subscription = hub.subscribe(set(types.split(",")) if types else None)
-    receiver = asyncio.create_task(_drain(socket))
+    receiver = asyncio.create_task(_drain(socket, lambda text: _client_message(text, socket, control, motion, client)))
     try:
         await socket.send_json({"type": "hello", "client": client})
         while not receiver.done():
@@ -72,11 +82,28 @@ async def events_socket(
         motion.disconnect(client, manager)  # returns at once: the quick stops run on their own thread
 
 
-async def _drain(socket: WebSocket) -> None:
-    """Read (and ignore) client messages until it disconnects."""
+async def _drain(socket: WebSocket, handle: Callable[[str], None]) -> None:
+    """Read client messages until it disconnects."""
     with contextlib.suppress(WebSocketDisconnect):
         while True:
-            await socket.receive_text()
+            handle(await socket.receive_text())
+
+
+def _client_message(text: str, socket: WebSocket, control: AccessControl, motion: MotionGuard, client: str) -> None:
+    """A keepalive keeps the client's hold-to-run motion of that axis going (at once, on the loop: it is a
+    timestamp); one that is malformed, of a caller below its level, or for an axis the client holds no motion of
+    keeps nothing alive, and the motion stops when its hold times out."""
+    try:
+        message = json.loads(text)
+    except ValueError:
+        return
+    if not isinstance(message, dict) or message.get("type") != "keepalive":
+        return
+    try:
+        require_message(identify(socket, control), EVENT_MESSAGES, "keepalive", "events")
+        motion.keepalive(client, (str(message["bus"]), int(message["node"])))
+    except (ServoStudioError, KeyError, TypeError, ValueError) as refusal:
+        log.debug("keepalive of client %s ignored: %s", client, refusal)
 
 
 @router.websocket("/ws/terminal", dependencies=[Requires(Level.OPERATOR)])

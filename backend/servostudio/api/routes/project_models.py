@@ -98,6 +98,22 @@ class ParameterList(BaseModel):
 class ParameterWrite(BaseModel):
     values: dict[str, int | float | str] = Field(examples=[{"0x6060": -3, "0x60F9,2": 1200}])
     revision: str | None = None
+    keep_revision: bool = Field(
+        default=False,
+        description="keep the project as it was before this change restorable (GET/POST …/revisions): "
+        "for a change that replaces many values, such as a backup of the drive into the project",
+    )
+
+
+class KeptRevisionModel(BaseModel):
+    revision: str = Field(description="the project's revision before the change that replaced it")
+    saved_at: float = Field(description="when it was replaced (epoch seconds)")
+    reason: str = Field(description="what replaced it")
+    files: int
+
+
+class RevisionRestore(BaseModel):
+    revision: str | None = Field(default=None, description="the project's current revision (refused if it changed)")
 
 
 class ParameterReset(BaseModel):
@@ -122,6 +138,11 @@ class CompareModel(BaseModel):
     rows: list[CompareRowModel]
     revision: str
     refused: dict[str, str] = Field(default={}, description="objects the drive refused to read: address -> reason")
+    read_only: list[CompareRowModel] = Field(
+        default=[],
+        description="with ?read_only=true: the read-only entries (error register, status word, measurements), "
+        "apart from rows and never counted as differences: nobody writes or restores them",
+    )
 
 
 class AxisChoiceModel(BaseModel):

@@ -8,6 +8,7 @@ Changes take the ``revision`` the client last read; when someone else changed th
 
 from __future__ import annotations
 
+import dataclasses
 import shutil
 import tempfile
 from pathlib import Path
@@ -30,6 +31,7 @@ from servostudio.api.routes.project_models import (
     AxisUpdate,
     CompareModel,
     CompareRowModel,
+    KeptRevisionModel,
     MotorChoice,
     MotorModel,
     NewName,
@@ -41,6 +43,7 @@ from servostudio.api.routes.project_models import (
     ProjectModel,
     ProjectSummary,
     ProjectUpdate,
+    RevisionRestore,
     TemplateChoice,
     TemplateModel,
     buses_from,
@@ -138,6 +141,22 @@ def duplicate_project(name: str, body: NewName, service: Projects) -> ProjectMod
     return project_model(service.store.duplicate(name, body.new_name))
 
 
+@router.get(
+    "/projects/{name}/revisions", response_model=list[KeptRevisionModel], dependencies=[Requires(Level.OPERATOR)]
+)
+def list_revisions(name: str, service: Projects) -> list[KeptRevisionModel]:
+    """The kept revisions, newest first: the project as it was before each change that replaced many values."""
+    return [KeptRevisionModel(**dataclasses.asdict(item)) for item in service.revisions(name)]
+
+
+@router.post(
+    "/projects/{name}/revisions/{revision}/restore", response_model=ProjectModel, dependencies=[Requires(Level.EXPERT)]
+)
+def restore_revision(name: str, revision: str, body: RevisionRestore, service: Projects) -> ProjectModel:
+    """Make the project what it was at a kept revision; the state it replaces is kept in turn (so this undoes)."""
+    return project_model(service.restore_revision(name, revision, body.revision))
+
+
 @router.get("/projects/{name}/archive", response_class=FileResponse, dependencies=[Requires(Level.OPERATOR)])
 def archive_project(name: str, service: Projects) -> FileResponse:
     scratch = tempfile.mkdtemp()
@@ -205,7 +224,8 @@ def get_parameter(name: str, axis: str, address: str, service: Projects) -> Para
     "/projects/{name}/axes/{axis}/parameters", response_model=ParameterList, dependencies=[Requires(Level.EXPERT)]
 )
 def set_parameters(name: str, axis: str, body: ParameterWrite, service: Projects) -> ParameterList:
-    change = service.parameters.set(name, axis, body.values, body.revision)
+    keep = f"{len(body.values)} values of axis {axis} replaced" if body.keep_revision else None
+    change = service.parameters.set(name, axis, body.values, body.revision, keep)
     return ParameterList(parameters=[parameter_model(row) for row in change.rows], revision=change.revision)
 
 
@@ -231,20 +251,27 @@ def compare_axis(
     group: str | None = None,
     only_differences: bool = False,
     drive: bool = False,
+    read_only: bool = False,
 ) -> CompareModel:
     """Project / default columns; with ``drive=true`` drive / project / default, read from the axis's live drive
-    (its bus is opened on the server if needed), and a row differs when the drive's value is not the project's."""
+    (its bus is opened on the server if needed), and a row differs when the drive's value is not the project's.
+    Rows are what a user can write or restore; ``read_only=true`` adds the read-only entries apart (``read_only``)."""
     if drive:
-        found = live.compare(name, axis, group=group, only_differences=only_differences)
+        found = live.compare(name, axis, group=group, only_differences=only_differences, read_only=read_only)
         return CompareModel(
             columns=["drive", "project", "default"],
             revision=found.revision,
             refused=found.refused,
             rows=[CompareRowModel(**compare_view(row)) for row in found.rows],
+            read_only=[CompareRowModel(**compare_view(row)) for row in found.read_only],
         )
     rows, revision = service.parameters.compare(name, axis, group=group, only_differences=only_differences)
+    apart = service.parameters.read_only(name, axis, group=group) if read_only else []
     return CompareModel(
-        columns=["project", "default"], revision=revision, rows=[CompareRowModel(**compare_view(row)) for row in rows]
+        columns=["project", "default"],
+        revision=revision,
+        rows=[CompareRowModel(**compare_view(row)) for row in rows],
+        read_only=[CompareRowModel(**compare_view(row)) for row in apart],
     )
 
 

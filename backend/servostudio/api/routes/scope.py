@@ -19,18 +19,18 @@ from servostudio.api.routes.drives import DRIVE_ERRORS
 from servostudio.api.routes.scope_models import (
     CaptureModel,
     CaptureRequest,
-    ChannelModel,
     PlanModel,
     RecorderStatus,
     SavedCaptureModel,
     SaveRequest,
     ScopeInfo,
     capture_model,
+    plan_model,
     saved_model,
 )
 from servostudio.api.security import Requires
 from servostudio.errors import ErrorKind
-from servostudio.services.scope import Capture, CaptureStore, ChannelInfo, capture_csv, capture_html, check
+from servostudio.services.scope import Capture, CaptureStore, capture_csv, capture_html, check
 from servostudio.services.scope.service import UnknownCapture
 from servostudio.services.users import Level
 
@@ -57,21 +57,13 @@ def get_scope(drive: NodeDrive, scope: ScopeCaptures) -> dict:
 @router.post(
     f"{LIVE}/check",
     response_model=PlanModel,
-    summary="Check a capture definition against the drive without arming anything (422 says why not)",
+    summary="Check a capture definition without arming anything: the plan, with the rate and bus load of a TPDO "
+    "or polled capture (422 says why not)",
     responses=error_responses(*DRIVE_ERRORS),
     dependencies=[Requires(Level.OPERATOR)],
 )
-def check_capture(request: CaptureRequest, drive: NodeDrive) -> PlanModel:
-    plan = check(drive, request.definition())
-    return PlanModel(
-        channels=[ChannelModel(**vars(ChannelInfo.of(channel.variable))) for channel in plan.channels],
-        period_ns=plan.period_ns,
-        multiplier=plan.multiplier,
-        samples=plan.depth,
-        pre_trigger=plan.pre_trigger,
-        record_size=plan.record_size,
-        bytes=plan.total_bytes,
-    )
+def check_capture(request: CaptureRequest, connection: OpenBus, drive: NodeDrive) -> PlanModel:
+    return plan_model(check(drive, request.definition(), connection.drive, connection.spec.bitrate))
 
 
 @router.post(

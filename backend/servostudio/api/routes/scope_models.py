@@ -8,7 +8,9 @@ from typing import Annotated, Literal
 
 from pydantic import BaseModel, ConfigDict, Field
 
-from servostudio.services.scope import Capture, CaptureDefinition, SavedCapture, Trigger
+from servostudio.services.scope import Capture, CaptureDefinition, ChannelInfo, SavedCapture, Trigger
+from servostudio.services.scope.plan import CapturePlan
+from servostudio.services.scope.stream_plan import StreamPlan
 
 #: an object as a client names it: address (0x606C,0), name or profile name
 ObjectName = Annotated[str, Field(min_length=1, max_length=80)]
@@ -50,6 +52,9 @@ class CaptureRequest(BaseModel):
     mode: Literal["single", "normal", "auto"] = "single"
     auto_timeout_ms: int = Field(100, ge=0, le=10**9)
     timeout_s: float | None = Field(None, gt=0, le=86400, description="give up when no recording completes by then")
+    source: Literal["auto", "recorder", "tpdo", "poll"] = Field(
+        "auto", description="the drive's recorder, synchronous TPDOs at the server's SYNC, or SDO polling"
+    )
 
     def definition(self) -> CaptureDefinition:
         fields = self.model_dump()
@@ -70,11 +75,12 @@ class PresetModel(BaseModel):
 
 
 class ScopeInfo(BaseModel):
-    """The drive's recorder: its limits, its status and the presets this drive can run."""
+    """The drive's recorder (or, without one, the TPDO capture's limits): its status and the presets it can run."""
 
+    source: Literal["recorder", "tpdo", "poll"] = Field(description="how this drive's captures are taken")
     channels: int
-    capacity: int = Field(description="bytes of one recording")
-    base_period_ns: int
+    capacity: int | None = Field(description="bytes of one recording (none without a recorder)")
+    base_period_ns: int = Field(description="the shortest period: the control period, or the server's 1 ms SYNC")
     status: str
     presets: list[PresetModel]
 
@@ -94,16 +100,40 @@ class ChannelModel(BaseModel):
     offset: float
 
 
-class PlanModel(BaseModel):
-    """A definition the drive accepts, as the recorder will run it."""
+class TpdoUseModel(BaseModel):
+    node: int
+    tpdo: int = Field(description="the TPDO's number, 1-based")
+    channels: int
 
+
+class StreamPlanModel(BaseModel):
+    """A capture without the recorder: the rate and the bus load it will make, stated before arming."""
+
+    rate_hz: float
+    min_period_ns: int = Field(description="the shortest period this capture could have")
+    frames_per_s: float
+    bus_load: float = Field(description="share of the bus (worst-case stuff bits), 0..1")
+    bitrate: int
+    bitrate_assumed: bool = Field(description="the bus spec does not give the bit rate: 1 Mbit/s assumed")
+    nodes: list[int]
+    tpdos: list[TpdoUseModel]
+    alignment: str = Field(description="how the channels and axes line up in time")
+
+
+class PlanModel(BaseModel):
+    """A definition the drive accepts, as the recorder (or the TPDOs, or polling) will run it."""
+
+    source: Literal["recorder", "tpdo", "poll"]
     channels: list[ChannelModel]
     period_ns: int
-    multiplier: int
     samples: int
     pre_trigger: int
-    record_size: int
-    bytes: int
+    multiplier: int | None = Field(default=None, description="recorder: periods of the base period per sample")
+    record_size: int | None = Field(default=None, description="recorder: bytes per record")
+    bytes: int | None = Field(default=None, description="recorder: bytes of the recording")
+    stream: StreamPlanModel | None = Field(
+        default=None, description="TPDO and polled captures: rate, bus load, alignment"
+    )
 
 
 class DriveIdentityModel(BaseModel):
@@ -131,6 +161,9 @@ class CaptureModel(BaseModel):
     drive: DriveIdentityModel
     captured_at: str
     source: str
+    alignment_ns: int | None = Field(
+        None, description="TPDO and polled captures: the largest distance of a sample from its instant"
+    )
 
 
 class SaveRequest(BaseModel):
@@ -164,6 +197,7 @@ def capture_model(capture: Capture, capture_id: str | None = None) -> CaptureMod
         drive=DriveIdentityModel(**vars(capture.drive)),
         captured_at=capture.captured_at,
         source=capture.source,
+        alignment_ns=capture.alignment_ns,
     )
 
 
@@ -175,3 +209,27 @@ def _finite(value: float) -> float | None:
 def saved_model(saved: SavedCapture) -> SavedCaptureModel:
     fields = vars(saved) | {"channels": list(saved.channels)}
     return SavedCaptureModel(**fields)
+
+
+def plan_model(plan: CapturePlan | StreamPlan) -> PlanModel:
+    """The plan as the check route answers it."""
+    if isinstance(plan, StreamPlan):
+        preview = plan.describe()
+        return PlanModel(
+            source=plan.source,  # type: ignore[arg-type]
+            channels=[ChannelModel(**(vars(ChannelInfo.of(ch.variable)) | {"key": ch.key})) for ch in plan.channels],
+            period_ns=plan.period_ns,
+            samples=plan.depth,
+            pre_trigger=plan.pre_trigger,
+            stream=StreamPlanModel.model_validate(preview),
+        )
+    return PlanModel(
+        source="recorder",
+        channels=[ChannelModel(**vars(ChannelInfo.of(channel.variable))) for channel in plan.channels],
+        period_ns=plan.period_ns,
+        samples=plan.depth,
+        pre_trigger=plan.pre_trigger,
+        multiplier=plan.multiplier,
+        record_size=plan.record_size,
+        bytes=plan.total_bytes,
+    )

@@ -8,6 +8,7 @@ from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
 from servostudio.drive.faults import CodedBits, FaultInfo, cia402_error_text
+from servostudio.drive.profiles.procedures import NO_PROCEDURES, ProcedureSet
 from servostudio.errors import NotFound
 from servostudio.od.model import SaveType
 
@@ -48,6 +49,9 @@ CIA402_OBJECTS: dict[str, tuple[int, int]] = {
     "profile_deceleration": (0x6084, 0),
     "homing_speed_fast": (0x6099, 1),
     "homing_speed_slow": (0x6099, 2),
+    "homing_method": (0x6098, 0),
+    "homing_acceleration": (0x609A, 0),
+    "home_offset": (0x607C, 0),
     "position_offset": (0x60B0, 0),
     "velocity_offset": (0x60B1, 0),
     "torque_offset": (0x60B2, 0),
@@ -70,6 +74,9 @@ CIA402_MOTION_OBJECTS: frozenset[str] = frozenset(
         "profile_deceleration",
         "homing_speed_fast",
         "homing_speed_slow",
+        "homing_method",
+        "homing_acceleration",
+        "home_offset",
         "position_offset",
         "velocity_offset",
         "torque_offset",
@@ -149,8 +156,12 @@ class DeviceProfile:
     #: procedures that turn the motor by themselves, even with the power stage off (phasing, auto-tuning):
     #: semantic name of the trigger object → the signature that starts it
     moving_procedures: Mapping[str, str] = field(default_factory=dict)
+    #: homing methods (0x6098) the drive supports → the manual's description (``drive/profiles/homing.py``)
+    homing_methods: Mapping[int, str] = field(default_factory=dict)
     #: the in-drive oscilloscope recorder (XtrapulsPac); None: the drive has none
     recorder: RecorderDescription | None = None
+    #: the signature-started procedures (phasing, current loop, auto-tuning) as the procedure service runs them
+    procedures: ProcedureSet = NO_PROCEDURES
 
     def address(self, name: str) -> tuple[int, int]:
         try:

@@ -11,6 +11,9 @@ from __future__ import annotations
 
 from servostudio.drive.faults import CodedBits, FaultInfo
 from servostudio.drive.profiles.base import CIA301_OBJECTS, CIA402_OBJECTS, Addressing, DeviceProfile, EmcyLayout
+from servostudio.drive.profiles.cd1k_procedures import CD1K_PROCEDURES
+from servostudio.drive.profiles.homing import HOMING_METHODS
+from servostudio.drive.profiles.procedures import IDENTIFIED_PLANT_OBJECTS
 
 _STOP_MASKS = "Its stop (disable, stop 1 or stop 3) follows the masks 3330h / 3331h."
 
@@ -144,6 +147,25 @@ CD1K = DeviceProfile(
         "max_current_share": (0x6510, 5),
         "rated_current_share": (0x6510, 6),
         "pole_pairs": (0x6410, 2),
+        # procedures (services.procedures; drive/profiles/cd1k_procedures.py)
+        "phase_order": (0x6410, 3),
+        "sensor_offset": (0x6410, 4),
+        "kp_speed": (0x60F9, 1),
+        "ki_speed": (0x60F9, 2),
+        "kc_speed": (0x60F9, 4),
+        "kd_speed": (0x60F9, 7),
+        "kp_position": (0x60FB, 1),
+        "kf_position": (0x60FB, 2),
+        "ka_position": (0x60FB, 3),
+        "kb_position": (0x60FB, 4),
+        "tuning_bandwidth": (0x3420, 1),
+        "tuning_requirement": (0x3430, 0),
+        **IDENTIFIED_PLANT_OBJECTS,
+        "digital_inputs": (0x60FD, 0),
+        "digital_outputs": (0x60FE, 1),
+        "digital_output_mask": (0x60FE, 2),
+        "velocity_demand": (0x606B, 0),
+        "encoder_increments": (0x608F, 1),
     },
     signatures={"save": ("store_parameters", "save")},
     error_words=(("drive_error_word", 1),),
@@ -164,4 +186,6 @@ CD1K = DeviceProfile(
         "motor_phasing": ("max_current_share", "rated_current_share", "pole_pairs"),
         "auto_tuning": ("max_current_share", "rated_current_share"),
     },
+    procedures=CD1K_PROCEDURES,
+    homing_methods=HOMING_METHODS,
 )

@@ -21,9 +21,10 @@ from servostudio.drive.monitor import BusMonitor
 from servostudio.drive.nmt import NmtCommand, send_nmt
 from servostudio.drive.profiles import DeviceProfile, profile_for
 from servostudio.drive.sdo import SdoEngine
-from servostudio.errors import Conflict, NotFound
+from servostudio.errors import Conflict, InvalidInput, NotFound, ServoStudioError
 from servostudio.od.library import EdsLibrary, builtin_library
 from servostudio.services.bus.events import EventHub
+from servostudio.services.bus.share import BusShare, NotShared, ShareStatus
 from servostudio.services.bus.statewatch import StatuswordWatch
 from servostudio.services.motion import MotionGuard
 from servostudio.transport.open import open_bus
@@ -31,6 +32,7 @@ from servostudio.transport.spec import BusSpec, parse_bus_spec
 
 SERIAL_SDO_TIMEOUT = 1.0  # at 19200 baud a request and its answer alone take 12.5 ms, a forwarded one more
 CAN_SDO_TIMEOUT = 0.5
+DEFAULT_SHARE_HOST = "127.0.0.1"
 
 
 class UnknownBusOrNode(NotFound):
@@ -39,6 +41,37 @@ class UnknownBusOrNode(NotFound):
 
 class BusNameTaken(Conflict):
     """Another bus is already open under the name asked for."""
+
+
+@dataclass(frozen=True)
+class BusMatch:
+    """Which open bus a project's bus is: ``by`` ``name`` (same name and spec), ``spec`` (the spec is open under
+    another name), ``name_only`` (an open bus of that name has another spec), or None (not open)."""
+
+    name: str
+    spec: str
+    bus: str | None
+    by: str | None
+
+    def as_dict(self) -> dict[str, object]:
+        return asdict(self)
+
+
+def parse_share(text: str) -> tuple[str, str, int]:
+    """``BUS=PORT`` or ``BUS=HOST:PORT`` (``serve --share``) → (bus name or spec, host, port)."""
+    bus, equals, address = text.rpartition("=")
+    host, _, port = address.rpartition(":")
+    if not equals or not bus or not port.isdigit():
+        raise BadShare(f"--share {text!r}: expected BUS=PORT or BUS=HOST:PORT, e.g. sim=29540")
+    return bus, host.strip("[]") or DEFAULT_SHARE_HOST, int(port)
+
+
+class BadShare(InvalidInput):
+    """A ``--share`` that is not BUS=[HOST:]PORT."""
+
+
+class BusAlreadyOpen(Conflict):
+    """The spec asked for under a new name is open already, under its own name."""
 
 
 class Simulation(Protocol):
@@ -78,6 +111,7 @@ class BusConnection:
     simulation: Simulation | None = None  # the simulated drives of a ``sim`` bus, stopped with it
     gate: WriteGate = OPEN_GATE  # every write of the bus's drives passes it: the manager's motion guard
     monitor: BusMonitor | None = None
+    share: BusShare | None = None  # its socketcand endpoint for the user's own scripts, when shared
     _identifying: dict[int, threading.Lock] = field(default_factory=dict, repr=False)
     _identifying_guard: threading.Lock = field(default_factory=threading.Lock, repr=False)
 
@@ -139,7 +173,25 @@ class BusConnection:
             "nodes": [info.as_dict() for info in sorted(self.nodes.values(), key=lambda item: item.node)],
         }
 
+    def share_on(self, host: str = DEFAULT_SHARE_HOST, port: int = 0) -> ShareStatus:
+        """Share the bus as a socketcand endpoint (port 0: any free one); an existing share is kept as it is."""
+        if self.share is None:
+            self.share = BusShare(self, host, port)
+        return self.share.status()
+
+    def shared(self) -> ShareStatus:
+        """The bus's share, or `NotShared`."""
+        if self.share is None:
+            raise NotShared(f"bus {self.id} is not shared")
+        return self.share.status()
+
+    def share_off(self) -> None:
+        share, self.share = self.share, None
+        if share is not None:
+            share.close()
+
     def close(self) -> None:
+        self.share_off()
         self.link.close()
         if self.simulation is not None:
             self.simulation.stop()
@@ -159,7 +211,10 @@ class ConnectionManager:
         self._lock = threading.Lock()
 
     def open(self, spec_text: str, bus_id: str | None = None, wait: float = 2.0) -> BusConnection:
-        """Open (or re-use) the bus a spec names; waits up to ``wait`` s for the first connection."""
+        """Open (or re-use) the bus a spec names; waits up to ``wait`` s for the first connection.
+
+        The same spec (any spelling of it) is one bus: it is returned under its name, whatever ``bus_id`` asks
+        (`opened` tells a caller that must say so)."""
         spec = parse_bus_spec(spec_text)
         with self._lock:
             for existing in self._buses.values():
@@ -206,6 +261,47 @@ class ConnectionManager:
         network = SimulatedNetwork(spec.channel)
         network.start()
         return (lambda: network.open_bus()), network
+
+    def opened(self, spec_text: str, bus_id: str | None = None, wait: float = 2.0) -> tuple[BusConnection, bool]:
+        """`open`, and whether the bus was open already.  An open spec asked for under another name is refused
+        (`BusAlreadyOpen`, naming it): one bus has one name, and a caller that wanted a second bus must know."""
+        existing = self.find(spec_text)
+        if existing is None:
+            return self.open(spec_text, bus_id, wait), False
+        if bus_id is not None and bus_id != existing.id:
+            raise BusAlreadyOpen(f"{existing.spec} is open already as bus {existing.id!r}; use that name")
+        return existing, True
+
+    def find(self, spec_text: str) -> BusConnection | None:
+        """The open bus of a spec, however it is spelt (``socketcand:h:p`` is ``socketcand:h:p/can0``)."""
+        spec = parse_bus_spec(spec_text)
+        return next((bus for bus in self._buses.values() if bus.spec == spec), None)
+
+    def match(self, name: str, spec_text: str) -> BusMatch:
+        """The open bus a project's bus (its name and spec) is: the one with its spec, else the one of its name."""
+        try:
+            by_spec = self.find(spec_text)
+        except ServoStudioError:
+            by_spec = None
+        if by_spec is not None:
+            return BusMatch(name, spec_text, by_spec.id, "spec" if by_spec.id != name else "name")
+        if name in self._buses:
+            return BusMatch(name, spec_text, name, "name_only")
+        return BusMatch(name, spec_text, None, None)
+
+    def share(self, bus: str, host: str = DEFAULT_SHARE_HOST, port: int = 0) -> ShareStatus:
+        """Share an open bus (by name or spec) as a socketcand endpoint for the user's own scripts."""
+        return self.named(bus).share_on(host, port)
+
+    def named(self, bus: str) -> BusConnection:
+        """An open bus by its name, or by its spec however spelt."""
+        if bus in self._buses:
+            return self._buses[bus]
+        try:
+            found = self.find(bus)
+        except ServoStudioError:
+            found = None
+        return found if found is not None else self.get(bus)
 
     def get(self, bus_id: str) -> BusConnection:
         try:

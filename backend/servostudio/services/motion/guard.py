@@ -25,12 +25,13 @@ from concurrent.futures import CancelledError, Future
 from typing import TYPE_CHECKING, TypeGuard
 
 from servostudio.drive.access import Drive, DriveAccessError, PlannedWrite, WriteOutcomes
-from servostudio.drive.cia402 import State
+from servostudio.drive.cia402 import Command, State
 from servostudio.drive.control import read_state, set_state
 from servostudio.errors import Forbidden, RefusedForSafety, ServoStudioError
 from servostudio.od.model import Variable
 from servostudio.services.audit import SERVER, Actor, AuditLog, acting_as, axis_name, current_actor, printable
 from servostudio.services.motion.control import Axis, Controllers, Holder, where
+from servostudio.services.motion.jog import Motions
 from servostudio.services.motion.verdict import NO_MOTION, Motion, MotionObjects, Verdict, judge
 
 if TYPE_CHECKING:
@@ -69,6 +70,8 @@ class MotionGuard:
         self.publish = publish
         self.audit = audit if audit is not None else AuditLog(None)
         self._objects: dict[str, MotionObjects] = {}
+        #: the quick test's jogs, moves and homing, each started through this guard (``jog``)
+        self.motions = Motions(self)
 
     def gate(self, bus: str) -> BusGate:
         return BusGate(self, bus)
@@ -215,14 +218,25 @@ class MotionGuard:
             except Exception:  # a bug must not leave the other axes running
                 log.exception("client %s went away: quick stop of %s failed", client, where(axis))
 
-    def _stop_if_enabled(self, axis: Axis, drive: Drive, why: str) -> None:
+    def quick_stop(self, axis: Axis, drive: Drive, why: str, running: bool = False) -> None:
+        """Quick-stop the axis if it is enabled, as the server (a stop route, the hold-to-run watchdog).  ``running``:
+        the caller just saw it run, so the quick stop is written without reading the state first (one round trip
+        less between a lost keepalive and the stop; the guard still judges the write)."""
+        self._stop_if_enabled(axis, drive, why, running)
+
+    def keepalive(self, client: str, axis: Axis) -> bool:
+        """A hold-to-run keepalive from the client's event socket; False when it holds no motion of the axis."""
+        return self.motions.keepalive(client, axis)
+
+    def _stop_if_enabled(self, axis: Axis, drive: Drive, why: str, running: bool = False) -> None:
         """Quick stop, done by the server itself: the axis must not run without an armed controller."""
         with acting_as(SERVER):
-            if read_state(drive)[0] is not State.OPERATION_ENABLED:
+            if not running and read_state(drive)[0] is not State.OPERATION_ENABLED:
                 return
             entry = {"action": "quick_stop", "axis": axis_name(*axis), "detail": why}
             try:
-                set_state(drive, State.QUICK_STOP_ACTIVE)
+                drive.write("controlword", int(Command.QUICK_STOP))  # at once: one write, no read of it first
+                set_state(drive, State.QUICK_STOP_ACTIVE)  # and checked: the drive took it (or went further down)
             except ServoStudioError as error:
                 self.audit.record([entry | {"result": "failed", "detail": f"{why}: {error}"}])
                 raise

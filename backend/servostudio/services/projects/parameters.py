@@ -6,6 +6,7 @@ plus the project rule that the object must be saved in a drive file; several val
 
 from __future__ import annotations
 
+import contextlib
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
 from typing import Protocol
@@ -16,6 +17,7 @@ from servostudio.services.projects.compare import CompareRow, DefaultValues, Par
 from servostudio.services.projects.errors import ParameterRefused, ProjectNotFound
 from servostudio.services.projects.model import Axis
 from servostudio.services.projects.parameter_values import Value
+from servostudio.services.projects.revisions import keeping
 from servostudio.services.projects.store import ProjectEdit, ProjectStore
 
 
@@ -87,12 +89,18 @@ class ParameterService:
             return parameter_row(values, values.resolve(address)), view.revision
 
     def set(
-        self, project: str, axis: str, changes: Mapping[str, object], expected_revision: str | None = None
+        self,
+        project: str,
+        axis: str,
+        changes: Mapping[str, object],
+        expected_revision: str | None = None,
+        keep: str | None = None,
     ) -> ParameterChange:
-        """Set several objects (address -> value) at once; any refusal leaves every file unchanged."""
+        """Set several objects (address -> value) at once; any refusal leaves every file unchanged. With ``keep``
+        (why), the project as it was stays restorable (``revisions``): a change that replaces many values."""
         if not changes:
             raise ParameterRefused("no parameter given")
-        with self.store.edit(project, expected_revision) as edit:
+        with self.store.edit(project, expected_revision) as edit, _keeping(edit, keep):
             values = self._load(edit, axis)
             touched = [values.resolve(address) for address in changes]
             for variable, raw in zip(touched, changes.values(), strict=True):
@@ -121,9 +129,9 @@ class ParameterService:
         only_differences: bool = False,
         drive: ParameterSource | None = None,
     ) -> tuple[list[CompareRow], str]:
-        """Columns project / default for every saved object of the axis; with a ``drive``, columns drive / project /
-        default for the objects drive and project exchange (:meth:`AxisValues.transferable`), and a row differs
-        when the drive's value is not the project's."""
+        """Columns project / default for every saved, writable object of the axis; with a ``drive``, columns drive /
+        project / default for the objects drive and project exchange (:meth:`AxisValues.transferable`), and a row
+        differs when the drive's value is not the project's. Read-only entries are apart: :meth:`read_only`."""
         with self.store.read(project) as view:
             values = self._load(view, axis)
             sources: dict[str, ParameterSource] = {}
@@ -132,7 +140,9 @@ class ParameterService:
             sources["project"] = ProjectValues(values)
             sources["default"] = DefaultValues(values.dictionary, values.node_id)
             if drive is None:
-                chosen = [v for v in values.dictionary.variables() if v.save_type is not SaveType.NONE]
+                chosen = [
+                    v for v in values.dictionary.variables() if v.save_type is not SaveType.NONE and v.access.writable
+                ]
             else:
                 chosen = values.transferable()
             rows = compare(
@@ -143,6 +153,25 @@ class ParameterService:
                 between=("drive", "project") if drive is not None else None,
             )
             return rows, view.revision
+
+    def read_only(
+        self, project: str, axis: str, *, group: str | None = None, drive: ParameterSource | None = None
+    ) -> list[CompareRow]:
+        """The entries a compare does not count: read-only ones (error register, status word, measurements), which
+        nobody writes or restores; shown apart, with the drive's value when there is a drive."""
+        with self.store.read(project) as view:
+            values = self._load(view, axis)
+            sources: dict[str, ParameterSource] = {} if drive is None else {"drive": drive}
+            sources["project"] = ProjectValues(values)
+            sources["default"] = DefaultValues(values.dictionary, values.node_id)
+            between = ("drive", "project") if drive is not None else None
+            return compare(sources, read_only_variables(values.dictionary), group=group, between=between)
+
+    def read_only_variables(self, project: str, axis: str, group: str | None = None) -> list[Variable]:
+        """The read-only entries of an axis (optionally one UI group): what a drive source must read for them."""
+        with self.store.read(project) as view:
+            variables = read_only_variables(self._load(view, axis).dictionary)
+        return [v for v in variables if group is None or v.group.casefold() == group.casefold()]
 
     def transferable(self, project: str, axis: str, group: str | None = None) -> list[Variable]:
         """The objects a compare with the drive covers (optionally one UI group): what a drive source must read."""
@@ -157,6 +186,15 @@ class ParameterService:
     def _load(self, edit: ProjectEdit, axis: str) -> AxisValues:
         chosen = edit.axis(axis)
         return AxisValues.load(edit.axis_directory(axis), self.dictionary(chosen), chosen.node_id)
+
+
+def read_only_variables(dictionary: ObjectDictionary) -> list[Variable]:
+    """Readable entries nobody can write: the drive changes them by itself, no download or restore sets them."""
+    return [v for v in dictionary.variables() if v.access.readable and not v.access.writable]
+
+
+def _keeping(edit: ProjectEdit, reason: str | None) -> contextlib.AbstractContextManager[None]:
+    return keeping(edit, reason) if reason else contextlib.nullcontext()
 
 
 def parameter_row(values: AxisValues, variable: Variable) -> ParameterRow:

@@ -18,8 +18,10 @@ from servostudio.services.projects.model import Project
 from servostudio.services.projects.motors import BUILTIN_MOTORS_DIR, MotorCatalog
 from servostudio.services.projects.motorselect import apply_motor
 from servostudio.services.projects.parameters import DictionaryLibrary, ParameterChange, ParameterService, parameter_row
+from servostudio.services.projects.revisions import KeptRevision, keeping, kept, restore
 from servostudio.services.projects.store import UNRECORDED, ProjectStore, Snapshot
 from servostudio.services.projects.templates import ApplicationTemplate, template
+from servostudio.services.projects.validation import validate_project
 
 
 @dataclass(frozen=True)
@@ -101,6 +103,17 @@ class ProjectService:
             values.commit(edit, axis)
         rows = [parameter_row(values, variable) for variable, _ in configured.values]
         return DcfImport(ParameterChange(rows, edit.revision), configured.skipped)
+
+    def revisions(self, project: str) -> list[KeptRevision]:
+        """The project's kept revisions, newest first (what changes that replaced many values overwrote)."""
+        with self.store.read(project) as view:
+            return kept(view.directory)
+
+    def restore_revision(self, project: str, revision: str, expected_revision: str | None = None) -> Snapshot:
+        """Make the project what it was at a kept revision; the state it replaces is kept in turn (undo)."""
+        with self.store.edit(project, expected_revision) as edit, keeping(edit, f"restore of revision {revision}"):
+            restore(edit, revision, lambda chosen: validate_project(chosen, self.library.devices()))
+        return Snapshot(edit.project, edit.revision)
 
     def archive(self, project: str, destination: Path) -> Path:
         return archive_project(self.store, project, destination)

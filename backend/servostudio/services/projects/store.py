@@ -396,15 +396,27 @@ def _switch_device_files(directory: Path, axis: Axis, device: str) -> None:
 def revision_of(directory: Path) -> str:
     """Hash of every file of the project (paths and contents): changes whenever anything in the project changes.
 
-    Saved oscilloscope captures (``<axis>/captures/``) are recordings, not settings: saving one must not make
-    another client's next parameter change a conflict, so they are left out (they are still archived)."""
+    Saved oscilloscope captures (``<axis>/captures/``) and procedure results (``<axis>/procedures/``) are records,
+    not settings: saving one must not make another client's next parameter change a conflict, so they are left out
+    (they are still archived)."""
     digest = hashlib.sha256()
-    for path in sorted(_project_files(directory)):
+    for path in setting_files(directory):
         relative = path.relative_to(directory).as_posix()
-        if relative.split("/")[1:2] == [layout.CAPTURES_DIR]:
-            continue
         digest.update(relative.encode() + b"\0" + path.read_bytes() + b"\0")
     return digest.hexdigest()[:16]
+
+
+def setting_files(directory: Path) -> list[Path]:
+    """The files that make a project's revision, sorted: every regular file but the records (captures, results)."""
+    return sorted(
+        path
+        for path in _project_files(directory)
+        if path.relative_to(directory).as_posix().split("/")[1:2] not in RECORD_DIRS
+    )
+
+
+#: second path components (``<axis>/<dir>/…``) whose files are records, not settings
+RECORD_DIRS = ([layout.CAPTURES_DIR], [layout.PROCEDURES_DIR])
 
 
 def _project_files(directory: Path) -> Iterator[Path]:

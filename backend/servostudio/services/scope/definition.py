@@ -15,6 +15,11 @@ from servostudio.errors import InvalidInput
 
 EDGES = ("rising", "falling", "either")
 MODES = ("single", "normal", "auto")
+#: how the samples are taken: the drive's recorder, synchronous TPDOs at the server's SYNC, SDO polling; ``auto``
+#: picks the first the capture allows (the recorder for one drive that has one, else TPDOs, else polling)
+SOURCES = ("auto", "recorder", "tpdo", "poll")
+#: a channel of another axis of the bus: ``0x606C,0@2`` (the object, then its node)
+NODE_SEPARATOR = "@"
 DEFAULT_PERIOD_US = 250.0
 DEFAULT_SAMPLES = 2048
 
@@ -61,6 +66,7 @@ class CaptureDefinition:
     auto_timeout_ms: int = 100
     #: seconds to wait for the recording to complete (None: until stopped)
     timeout_s: float | None = None
+    source: str = "auto"
 
     def __post_init__(self) -> None:
         if not self.channels:
@@ -69,6 +75,10 @@ class CaptureDefinition:
             raise DefinitionError(f"mode {self.mode!r}: use one of {', '.join(MODES)}")
         if not 0 <= self.pre_trigger_pct <= 100:
             raise DefinitionError(f"pre-trigger {number_text(self.pre_trigger_pct)} %: use 0..100 %")
+        if self.source not in SOURCES:
+            raise DefinitionError(f"source {self.source!r}: use one of {', '.join(SOURCES)}")
+        for channel in self.channels:
+            split_channel(channel)
         if self.timeout_s is not None and self.timeout_s <= 0:
             raise DefinitionError(f"timeout {number_text(self.timeout_s)} s: use a positive number of seconds")
 
@@ -92,6 +102,16 @@ class CaptureDefinition:
             return cls(**values)
         except TypeError as error:
             raise DefinitionError(f"capture definition: {error}") from None
+
+
+def split_channel(text: str) -> tuple[str, int | None]:
+    """A channel as (object, node): ``0x606C,0@2`` → ("0x606C,0", 2); without ``@`` the capture's own node (None)."""
+    name, separator, node = text.rpartition(NODE_SEPARATOR)
+    if not separator:
+        return text, None
+    if not name.strip() or not node.strip().isdigit() or not 1 <= int(node) <= 127:
+        raise DefinitionError(f"channel {text!r}: write OBJECT@NODE with a node 1..127, e.g. 0x606C,0@2")
+    return name.strip(), int(node)
 
 
 def parse_trigger(text: str) -> Trigger:

@@ -16,7 +16,13 @@ from servostudio.errors import InvalidInput
 from servostudio.od.datatypes import DataType
 from servostudio.od.model import Variable
 from servostudio.od.pointer import Pointer
-from servostudio.services.scope.definition import DEFAULT_SAMPLES, CaptureDefinition, fixed_point_text, number_text
+from servostudio.services.scope.definition import (
+    DEFAULT_SAMPLES,
+    CaptureDefinition,
+    fixed_point_text,
+    number_text,
+    split_channel,
+)
 
 #: what a channel or a trigger source can be: the numbers a TPDO can carry (docs/eds.md §6)
 RECORDABLE_TYPES = frozenset(
@@ -105,12 +111,12 @@ class CapturePlan:
 
 
 def recorder_of(drive: Drive) -> RecorderDescription:
-    """The drive's recorder description; a drive without one is refused (its TPDO captures come later)."""
+    """The drive's recorder description; a drive without one is refused (its captures use TPDOs or polling)."""
     recorder = drive.profile.recorder
     if recorder is None or drive.dictionary is None:
         raise NoRecorder(
-            f"node {drive.node} ({drive.profile.device}): no recorder: TPDO capture comes later "
-            "(issue #12, item 3); the XtrapulsPac records in the drive"
+            f"node {drive.node} ({drive.profile.device}): no recorder; its captures go through TPDOs at the "
+            "server's SYNC or by polling (source tpdo or poll)"
         )
     return recorder
 
@@ -119,7 +125,7 @@ def plan_capture(
     drive: Drive, recorder: RecorderDescription, limits: RecorderLimits, definition: CaptureDefinition
 ) -> CapturePlan:
     """Check ``definition`` against the drive's dictionary and recorder; the plan, or the reason it cannot be."""
-    channels = tuple(PlannedChannel(_recordable(drive, key, "channel")) for key in definition.channels)
+    channels = tuple(PlannedChannel(recordable(drive, split_channel(key)[0], "channel")) for key in definition.channels)
     if len(channels) > recorder.channels:
         raise CaptureRefused(f"{len(channels)} channels asked; the recorder has {recorder.channels}")
     multiplier = _multiplier(drive, recorder, limits, definition.period_us)
@@ -132,7 +138,7 @@ def plan_capture(
         base_period_ns=limits.base_period_ns,
         multiplier=multiplier,
         depth=depth,
-        pre_trigger=_pre_trigger(definition, depth),
+        pre_trigger=pre_trigger_samples(definition, depth),
         trigger_mode=recorder.trigger_modes["immediate" if definition.trigger.immediate else "edge"],
         trigger_source=source,
         trigger_variable=variable,
@@ -143,7 +149,7 @@ def plan_capture(
     )
 
 
-def _recordable(drive: Drive, key: str, role: str) -> Variable:
+def recordable(drive: Drive, key: str, role: str) -> Variable:
     """The object ``key`` names, if the recorder can sample it (the rule of a TPDO mapping entry)."""
     try:
         variable = drive.variable(key)
@@ -213,13 +219,13 @@ def _trigger(
     trigger = definition.trigger
     if trigger.source is None:
         return 1, None, 0, recorder.edges["rising"]
-    variable = _recordable(drive, trigger.source, "trigger source")
+    variable = recordable(drive, trigger.source, "trigger source")
     numbers = [number for number, channel in enumerate(channels, 1) if channel.variable.key == variable.key]
     source = numbers[0] if numbers else PlannedChannel(variable).pointer
-    return source, variable, _raw_level(variable, trigger.edge, trigger.level), recorder.edges[trigger.edge]
+    return source, variable, raw_level(variable, trigger.edge, trigger.level), recorder.edges[trigger.edge]
 
 
-def _raw_level(variable: Variable, edge: str, level: float) -> int:
+def raw_level(variable: Variable, edge: str, level: float) -> int:
     """The level as the recorder compares it (raw, signed 32 bits), refused when the source can never cross it."""
     raw = round(variable.from_physical(level))
     low, high = variable.minimum, variable.maximum
@@ -240,7 +246,7 @@ def _raw_level(variable: Variable, edge: str, level: float) -> int:
     return raw
 
 
-def _pre_trigger(definition: CaptureDefinition, depth: int) -> int:
+def pre_trigger_samples(definition: CaptureDefinition, depth: int) -> int:
     if definition.trigger.immediate:
         if definition.pre_trigger_pct:
             raise CaptureRefused("a pre-trigger needs a trigger: an immediate capture starts at the arm")

@@ -1,8 +1,9 @@
 """The drive's recorder driven over SDO: configure, arm, force, stop, watch the status, upload the recording.
 
-The steps are those of docs/scope.md §1. The upload reads the recording in parts through 0x5840,1/2 and 0x5841
-(segmented SDO: the engine of ``drive.sdo`` has no block transfer), so a capture reports its progress and can be
-cancelled between two parts; the recording counter read before and after proves the parts are one recording.
+The steps are those of docs/scope.md §1. The upload reads the whole recording (the DOMAIN 0x5801) in one block
+SDO upload — segmented where the drive refuses blocks (``drive.sdo``) — reporting its progress after every block
+and stoppable between two blocks; the drive takes the recording's bytes when the upload starts, and the recording
+counter read before and after proves they are the recording the capture waited for.
 """
 
 from __future__ import annotations
@@ -13,6 +14,7 @@ from dataclasses import dataclass
 
 from servostudio.drive.access import Drive
 from servostudio.drive.profiles.recorder import RecorderDescription
+from servostudio.drive.sdo import LARGE_SAFETY_WAIT, SdoStopped, settle
 from servostudio.errors import CommunicationError, Conflict, ServoStudioError, Timeout
 from servostudio.od.datatypes import DataType
 from servostudio.od.model import Variable
@@ -21,8 +23,6 @@ from servostudio.services.scope.plan import CapturePlan, RecorderLimits
 
 #: how often the status is read while waiting (an SDO read costs the bus about 0.2 ms)
 POLL_SECONDS = 0.02
-#: bytes per upload part: progress about 8 times per full buffer for one extra write per part (< 1 % of the frames)
-PART_BYTES = 4096
 
 #: what a progress callback hears: ``{"stage": "waiting"}``, ``{"stage": "uploading", "done": …, "total": …}``
 Report = Callable[[dict[str, object]], None]
@@ -104,8 +104,6 @@ class RecorderSession:
             "auto_timeout": plan.auto_timeout_ms,
             "trigger_level": plan.trigger_level,
             "trigger_edge": plan.trigger_edge,
-            "part_first": 0,
-            "part_count": max(1, PART_BYTES // plan.record_size),
         }
         return [(self.drive.variable(self.recorder.address(name)), value) for name, value in settings.items()]
 
@@ -159,7 +157,7 @@ class RecorderSession:
 
     # -- upload --------------------------------------------------------------------------------------------------
     def upload(self, plan: CapturePlan, report: Report, cancellation: Cancellation) -> Recording:
-        """The last complete recording, read in parts; any failure leaves nothing behind but the error."""
+        """The last complete recording; any failure leaves nothing behind but the error."""
         try:
             return self._upload(plan, report, cancellation)
         except (Cancelled, UploadFailed):
@@ -172,24 +170,24 @@ class RecorderSession:
 
     def _upload(self, plan: CapturePlan, report: Report, cancellation: Cancellation) -> Recording:
         counter, records, trigger = self.read("counter"), self.read("records"), self.read("trigger_record")
-        total, per_part = records * plan.record_size, max(1, PART_BYTES // plan.record_size)
-        data = bytearray()
+        total = records * plan.record_size
         report({"stage": "uploading", "done": 0, "total": total})
-        for first in range(0, records, per_part):
-            cancellation.check("the upload completed")
-            self.write("part_first", first)
-            data += self._part()
-            report({"stage": "uploading", "done": len(data), "total": total})
-        self.write("part_first", 0)
+        index, sub = self.recorder.address("buffer")
+        future = self.drive.engine.upload_block(
+            self.drive.node,
+            index,
+            sub,
+            progress=lambda done, _: report({"stage": "uploading", "done": min(done, total), "total": total}),
+            stop=lambda: cancellation.requested,
+        )
+        try:
+            data = settle(future, LARGE_SAFETY_WAIT)
+        except SdoStopped:
+            raise Cancelled("capture stopped during the upload; nothing was kept") from None
         if len(data) != total or self.read("counter") != counter:
             raise UploadFailed(
                 f"node {self.drive.node}: the drive changed the recording during the upload "
                 f"({len(data)} of {total} bytes); nothing was kept"
             )
-        return Recording(bytes(data), trigger, records, counter)
-
-    def _part(self) -> bytes:
-        """The records 0x5841 gives now (from ``part_first``, ``part_count`` of them)."""
-        value = self.drive.read(self.recorder.address("part")).raw
-        assert isinstance(value, bytes)
-        return value
+        report({"stage": "uploading", "done": total, "total": total})
+        return Recording(data, trigger, records, counter)

@@ -4,8 +4,10 @@ and the scope page.
 A capture is: check the definition against the drive (``plan``, refusals before anything is written), configure and
 arm the recorder, watch it until the recording is complete, read it back, convert it (``capture``). In single mode
 that is one recording; in normal and auto mode a server job records again and again until stopped, each recording
-frozen (stop) while it is read and the recorder armed again after. The server keeps the latest captures in memory
-by id for the page to fetch, export or save in the project (``store``).
+frozen (stop) while it is read and the recorder armed again after. A drive without a recorder, channels of several
+axes, or a definition that asks for it, is captured through synchronous TPDOs at the server's SYNC, or by polling
+(``stream_plan``, ``stream``). The server keeps the latest captures in memory by id for the page to fetch, export or
+save in the project (``store``).
 """
 
 from __future__ import annotations
@@ -16,16 +18,22 @@ import threading
 import time
 from collections import OrderedDict
 from collections.abc import Callable
+from dataclasses import replace
+from datetime import UTC, datetime
 
 from servostudio.drive.access import Drive
+from servostudio.drive.sync import MIN_PERIOD_S
+from servostudio.drive.tpdo import tpdo_slots
 from servostudio.errors import Conflict, NotFound
 from servostudio.services.bus import BusConnection, Job, JobRegistry
 from servostudio.services.cancel import Cancellation, Cancelled
-from servostudio.services.scope.capture import Capture, DriveIdentity, build_capture
-from servostudio.services.scope.definition import CaptureDefinition
-from servostudio.services.scope.plan import CapturePlan, plan_capture, recorder_of
+from servostudio.services.scope.capture import Capture, ChannelInfo, DriveIdentity, build_capture
+from servostudio.services.scope.definition import CaptureDefinition, split_channel
+from servostudio.services.scope.plan import CapturePlan, CaptureRefused, plan_capture, recorder_of
 from servostudio.services.scope.presets import presets_for
 from servostudio.services.scope.recorder import POLL_SECONDS, RecorderSession, Report
+from servostudio.services.scope.stream import PollStream, StreamResult, TpdoStream
+from servostudio.services.scope.stream_plan import Axes, Bus, StreamPlan, plan_stream
 
 #: captures the server keeps for its clients (a 4 × 2048 capture is about 0.3 MB in memory)
 KEEP_CAPTURES = 16
@@ -63,10 +71,31 @@ def session_of(drive: Drive) -> RecorderSession:
     return RecorderSession(drive, recorder_of(drive))
 
 
-def check(drive: Drive, definition: CaptureDefinition) -> CapturePlan:
-    """The plan of a capture, or its refusal; reads only the recorder's read-only limits."""
-    session = session_of(drive)
-    return plan_capture(drive, session.recorder, session.limits(), definition)
+def by_recorder(drive: Drive, definition: CaptureDefinition) -> bool:
+    """Does this capture use the drive's recorder? Asked for, or (auto) one drive that has one."""
+    own = all(split_channel(channel)[1] in (None, drive.node) for channel in definition.channels)
+    if definition.source == "recorder" and not own:
+        raise CaptureRefused("channels of several axes are captured through TPDOs or by polling, not the recorder")
+    if definition.source == "recorder":
+        return True
+    return definition.source == "auto" and own and drive.profile.recorder is not None
+
+
+def check(drive: Drive, definition: CaptureDefinition, axes: Axes | None = None,
+          bitrate: int | None = None) -> CapturePlan | StreamPlan:  # fmt: skip
+    """The plan of a capture, or its refusal; reads only read-only objects (the recorder's limits; a poll plan
+    times one round of reads). ``axes`` gives the other nodes of the bus (channels ``OBJ@NODE``)."""
+    if by_recorder(drive, definition):
+        session = session_of(drive)
+        return plan_capture(drive, session.recorder, session.limits(), definition)
+    return plan_stream(drive, axes or _alone(drive), definition, Bus(bitrate), definition.source)
+
+
+def _alone(drive: Drive) -> Axes:
+    def axis(node: int) -> Drive:
+        raise CaptureRefused(f"channel of node {node}: this capture reaches node {drive.node} only")
+
+    return axis
 
 
 def record_once(session: RecorderSession, plan: CapturePlan, identity: DriveIdentity, report: Report,
@@ -83,12 +112,46 @@ def record_once(session: RecorderSession, plan: CapturePlan, identity: DriveIden
 
 
 def capture(drive: Drive, identity: DriveIdentity, definition: CaptureDefinition, report: Report | None = None,
-            cancellation: Cancellation | None = None) -> Capture:  # fmt: skip
+            cancellation: Cancellation | None = None, axes: Axes | None = None,
+            bitrate: int | None = None) -> Capture:  # fmt: skip
     """One capture, start to end (what the CLI does; a job does it in a loop for normal and auto mode)."""
-    plan = check(drive, definition)
+    plan = check(drive, definition, axes, bitrate)
+    report, cancellation = report or _quiet, cancellation or Cancellation()
+    if isinstance(plan, StreamPlan):
+        return stream_once(drive, plan, identity, report, cancellation, axes)
     session = session_of(drive)
     session.configure(plan)
-    return record_once(session, plan, identity, report or _quiet, cancellation or Cancellation())
+    return record_once(session, plan, identity, report, cancellation)
+
+
+def stream_once(drive: Drive, plan: StreamPlan, identity: DriveIdentity, report: Report,
+                cancellation: Cancellation, axes: Axes | None) -> Capture:  # fmt: skip
+    """A capture through TPDOs or by polling (the plan says which)."""
+    reach = axes or _alone(drive)
+    nodes = {node: drive if node == drive.node else reach(node) for node in plan.nodes}
+    if plan.source == "tpdo":
+        result = TpdoStream(plan, nodes.__getitem__, drive.engine.link).run(report, cancellation)
+    else:
+        result = PollStream(plan, nodes.__getitem__).run(report, cancellation)
+    return streamed_capture(plan, result, identity)
+
+
+def streamed_capture(plan: StreamPlan, result: StreamResult, identity: DriveIdentity) -> Capture:
+    trigger = plan.definition.trigger
+    variable = plan.trigger_variable
+    source = None if variable is None else plan.channels[plan.trigger_channel or 0].key
+    return Capture(
+        definition=plan.definition,
+        channels=tuple(replace(ChannelInfo.of(channel.variable), key=channel.key) for channel in plan.channels),
+        period_ns=plan.period_ns,
+        trigger_index=result.trigger_index,
+        trigger=type(trigger)(source, trigger.edge, trigger.level).describe(variable.unit if variable else ""),
+        columns=result.columns,
+        drive=identity,
+        captured_at=datetime.now(UTC).isoformat(timespec="seconds").replace("+00:00", "Z"),
+        source=plan.source,
+        alignment_ns=result.alignment_ns,
+    )
 
 
 def _quiet(event: dict[str, object]) -> None:
@@ -106,44 +169,67 @@ class ScopeService:
         self._lock = threading.Lock()
 
     def describe(self, drive: Drive) -> dict[str, object]:
-        """What the page shows before a capture: the recorder's limits and the presets this drive can run."""
+        """What the page shows before a capture: the recorder's limits (or the TPDO capture's, for a drive without
+        one) and the presets this drive can run."""
+        return {**self._source_of(drive), "presets": self._presets(drive)}
+
+    def _source_of(self, drive: Drive) -> dict[str, object]:
+        if drive.profile.recorder is None:
+            slots = tpdo_slots(drive.dictionary) if drive.dictionary is not None else []
+            return {
+                "source": "tpdo" if slots else "poll",
+                "channels": min(4, 2 * len(slots)) if slots else 4,
+                "capacity": None,
+                "base_period_ns": round(MIN_PERIOD_S * 1e9),
+                "status": "idle",
+            }
         session = session_of(drive)
         limits = session.limits()
         return {
+            "source": "recorder",
             "channels": session.recorder.channels,
             "capacity": limits.capacity,
             "base_period_ns": limits.base_period_ns,
             "status": session.status(),
-            "presets": [
-                {
-                    "key": item.key,
-                    "title": item.title,
-                    "description": item.description,
-                    "definition": item.definition.as_dict(),
-                }
-                for item in presets_for(drive)
-            ],
         }
 
+    def _presets(self, drive: Drive) -> list[dict[str, object]]:
+        return [
+            {
+                "key": item.key,
+                "title": item.title,
+                "description": item.description,
+                "definition": item.definition.as_dict(),
+            }
+            for item in presets_for(drive)
+        ]
+
     def start(self, jobs: JobRegistry, connection: BusConnection, drive: Drive, definition: CaptureDefinition) -> Job:
-        """Check the definition now (a refusal is the caller's answer, not a failed job), then capture in a job."""
-        plan = check(drive, definition)
+        """Check the definition now (a refusal is the caller's answer, not a failed job), then capture in a job. The
+        job holds every node whose channels it captures."""
+        plan = check(drive, definition, connection.drive, connection.spec.bitrate)
         node = (connection.id, drive.node)
+        held = [(connection.id, other) for other in (plan.nodes if isinstance(plan, StreamPlan) else (drive.node,))]
         identity = identity_of(connection, drive)
         with self._lock:
-            running = self._running.get(node)
-            if running is not None and running.state == "running":
-                raise CaptureRunning(f"node {drive.node}: capture {running.id} is running; stop it first")
+            for other in held:
+                running = self._running.get(other)
+                if running is not None and running.state == "running":
+                    raise CaptureRunning(f"node {other[1]}: capture {running.id} is running; stop it first")
 
             def work(progress: Callable[[dict[str, object]], None], cancellation: Cancellation) -> object:
-                return self._run(drive, plan, identity, _on_node(progress, node), cancellation)
+                return self._run(drive, plan, identity, _on_node(progress, node), cancellation, connection.drive)
 
             job = jobs.start("scope", work)
-            self._running[node] = job
+            self._running.update(dict.fromkeys(held, job))
         return job
 
-    def _run(self, drive: Drive, plan: CapturePlan, identity: DriveIdentity, report: Report,
-             cancellation: Cancellation) -> dict[str, object]:  # fmt: skip
+    def _run(self, drive: Drive, plan: CapturePlan | StreamPlan, identity: DriveIdentity, report: Report,
+             cancellation: Cancellation, axes: Axes) -> dict[str, object]:  # fmt: skip
+        if isinstance(plan, StreamPlan):
+            streamed = self.remember(stream_once(drive, plan, identity, report, cancellation, axes))
+            report({"stage": "captured", "capture": streamed})
+            return {"capture": streamed, "captures": 1, "bus": identity.bus, "node": identity.node}
         session = session_of(drive)
         session.configure(plan)
         made: list[str] = []
@@ -184,18 +270,20 @@ class ScopeService:
             job = self._running.get((bus, drive.node))
         if job is not None:
             job.cancellation.cancel()
-        session = session_of(drive)
-        session.command("stop")
+        if drive.profile.recorder is not None:
+            session_of(drive).command("stop")
         deadline = time.monotonic() + STOP_WAIT
         while job is not None and job.state == "running" and time.monotonic() < deadline:
             time.sleep(POLL_SECONDS / 2)
-        return session.status()
+        return self.status(bus, drive)["status"]  # type: ignore[return-value]
 
     def status(self, bus: str, drive: Drive) -> dict[str, object]:
-        session = session_of(drive)
         with self._lock:
             job = self._running.get((bus, drive.node))
         running = job.id if job is not None and job.state == "running" else None
+        if drive.profile.recorder is None:  # the server assembles the capture: its job is the status
+            return {"status": "recording" if running else "idle", "counter": 0, "job": running}
+        session = session_of(drive)
         return {"status": session.status(), "counter": session.read("counter"), "job": running}
 
 

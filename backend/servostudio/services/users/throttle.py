@@ -33,7 +33,7 @@ class LoginThrottle:
         for key, limit in ((f"user:{name}", FAILURES_PER_USER), (f"address:{address}", FAILURES_PER_ADDRESS)):
             wait = self._wait(key, limit)
             if wait > 0:
-                raise TooManyLogins(f"too many failed logins ({key}); try again in {wait:.0f} s")
+                raise TooManyLogins(f"too many failed logins ({key}); try again in {wait:.0f} s", retry_after=wait)
 
     def _wait(self, key: str, limit: int) -> float:
         """Seconds until ``key`` may try again (0: now)."""

@@ -16,7 +16,7 @@ from __future__ import annotations
 
 from servostudio.sim.drive import errors
 from servostudio.sim.drive.behaviour import DriveBehaviour
-from servostudio.sim.drive.device_map import _COMMON_402, DeviceProfile
+from servostudio.sim.drive.device_map import _COMMON_402, IDENTIFIED_PLANT, DeviceProfile
 from servostudio.sim.drive.errors import DriveError
 from servostudio.sim.drive.statemachine import STOP_CURRENT_LIMIT, STOP_NONE, STOP_SLOW_DOWN_RAMP
 from servostudio.sim.drive.units import UnitScaling
@@ -64,6 +64,7 @@ CD1K = DeviceProfile(
         "brake_reaction_time": (0x3305, 0),
         "tuning_bandwidth": (0x3420, 1),
         "tuning_requirement": (0x3430, 0),
+        **IDENTIFIED_PLANT,
     },
     modes=frozenset({1, 3, 4, 6, 7}),
     procedures={"apha": (0x3410, 0), "mcal": (0x3414, 0), "atun": (0x3420, 2)},

@@ -9,7 +9,7 @@ from __future__ import annotations
 from servostudio.sim.drive import gains
 from servostudio.sim.plant import Plant
 
-COMMISSIONING_BANDWIDTH_HZ = 75.0
+COMMISSIONING_BANDWIDTH_HZ = 100.0
 
 
 def current_limits(stall_ma: float, peak_ma: float, drive_max_ma: float, drive_rated_ma: float) -> tuple[int, int]:

@@ -124,6 +124,15 @@ _COMMON_402: dict[str, Address] = {
     "undervoltage_threshold": (0x6510, 5),
 }
 
+IDENTIFIED_PLANT = {
+    "identified_inertia": (0x3428, 1),
+    "identified_viscous_friction": (0x3428, 2),
+    "identified_coulomb_friction": (0x3428, 3),
+    "identified_load_torque": (0x3428, 4),
+    "identified_residual": (0x3428, 5),
+}
+"""0x3428 "Identified plant" (issue #13's contract), written by auto-tuning on the XtrapulsPac and the CD1-k."""
+
 XTRAPULSPAC = DeviceProfile(
     key="xtrapulspac",
     objects=_COMMON_402
@@ -186,6 +195,7 @@ XTRAPULSPAC = DeviceProfile(
         "tuning_filter_type": (0x3425, 2),
         "tuning_speed_filter": (0x3425, 3),
         "tuning_requirement": (0x3425, 4),
+        **IDENTIFIED_PLANT,
         "device_status": (0x3441, 0),
     },
     modes=frozenset({1, 3, 4, 6, 7, MODE_SQ}),

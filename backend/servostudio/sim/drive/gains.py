@@ -77,6 +77,49 @@ class SpeedPositionGains:
     kav: int
     kbv: int
     speed_filter: int
+    current_filters: tuple[int, int, int] = (0, 0, 0)
+    """0x30F9,1..3 in Hz (0 = off)."""
+
+
+CROSSOVER_FACTOR = {50.0: 0.667, 75.0: 0.643, 100.0: 0.611}
+"""κ: the speed loop's gain crossover ωc = κ·2π·bandwidth. The PI zero at ωc/4, the speed-measurement filter, the
+current loop and the control period's delay make the closed loop peak and reach −3 dB well above ωc (about 1.8·ωc);
+κ was measured on the simulated loop (step response → frequency response) so that the −3 dB point lands on the
+requested bandwidth with the "auto" speed filter (docs/control-loops.md §4)."""
+
+
+def speed_loop_crossover(bandwidth_hz: float) -> float:
+    """ωc in rad/s for a requested closed-loop bandwidth."""
+    return CROSSOVER_FACTOR.get(bandwidth_hz, 0.64) * 2.0 * math.pi * bandwidth_hz
+
+
+def speed_filter_for(bandwidth_hz: float) -> int:
+    """0x30FA chosen by "auto": 0.5 ms for 75/100 Hz, 1 ms for 50 Hz."""
+    return 0 if bandwidth_hz >= 75.0 else 1
+
+
+ANTI_RESONANCE_CROSSOVER = 0.08
+"""Anti-resonance: the crossover is at most 0.1 × the coupling resonance, ..."""
+ANTI_RESONANCE_FILTER = 0.5
+"""... the three current-command filters sit at 0.5 × the resonance, ..."""
+ANTI_RESONANCE_INTEGRAL = 8.0
+"""... and the PI zero moves down to ωc/8 to give back the phase those filters take at the crossover."""
+ANTI_RESONANCE_FALLBACK = 4.0
+"""Anti-resonance without an identified resonance: one filter at 4 × the bandwidth."""
+
+
+def anti_resonance_design(bandwidth_hz: float, resonance_hz: float) -> tuple[float, float, tuple[int, int, int]]:
+    """(ωc in rad/s, PI-zero divisor, 0x30F9,1..3) of the anti-resonance filter type (docs/control-loops.md §4).
+
+    A load on an elastic coupling makes the motor see only its own inertia above the resonance, so the loop gain
+    there is (J/Jm) times the rigid one, on top of the resonance peak: it must be attenuated (three first-order
+    filters at half the resonance) and the crossover kept well below it (≤ resonance/10)."""
+    crossover = speed_loop_crossover(bandwidth_hz)
+    if resonance_hz <= 0.0:
+        return crossover, 4.0, (round(ANTI_RESONANCE_FALLBACK * bandwidth_hz), 0, 0)
+    crossover = min(crossover, ANTI_RESONANCE_CROSSOVER * 2.0 * math.pi * resonance_hz)
+    corner = max(20, min(1000, round(ANTI_RESONANCE_FILTER * resonance_hz)))
+    return crossover, ANTI_RESONANCE_INTEGRAL, (corner, corner, corner)
 
 
 def tuned_gains(
@@ -87,17 +130,25 @@ def tuned_gains(
     position_loop: bool = True,
     minimum_following_error: bool = True,
     viscous_friction: float = 0.0,
+    speed_filter: int | None = None,
+    anti_resonance: bool = False,
+    resonance_hz: float = 0.0,
 ) -> SpeedPositionGains:
-    """The auto-tuning rule (docs/control-loops.md):
+    """The auto-tuning rule (docs/control-loops.md §4):
 
-    ω = 2π·bandwidth; KPv = J·ω/Kt; KIv = KPv·ω/4; KCv = 0; KPp = ω/5;
+    ωc = κ·2π·bandwidth (CROSSOVER_FACTOR);
+    KPv = J·ωc/Kt; KIv = KPv·ωc/4; KCv = 0; KPp = ωc/5;
     minimum following error: KFp = full, KBv = KCv + B/Kt (viscous compensation), KAv = J/Kt;
     minimum overshoot: KFp = KBv = KAv = 0; a velocity-mode tuning leaves the position gains at 0.
+    anti-resonance: ωc, the PI zero and the current-command filters from `anti_resonance_design`.
     KJv is the smallest power-of-two multiple of 256 that keeps every scaled gain within U16.
     """
-    omega = 2.0 * math.pi * bandwidth_hz
+    selected = speed_filter_for(bandwidth_hz) if speed_filter is None else speed_filter
+    omega, divisor, filters = speed_loop_crossover(bandwidth_hz), 4.0, (0, 0, 0)
+    if anti_resonance:
+        omega, divisor, filters = anti_resonance_design(bandwidth_hz, resonance_hz)
     kpv = inertia * omega / torque_constant
-    kiv = kpv * omega / 4.0
+    kiv = kpv * omega / divisor
     kav = inertia / torque_constant if minimum_following_error else 0.0
     kbv = viscous_friction / torque_constant if minimum_following_error else 0.0
     scaled = (kpv / KPV_UNIT, kiv / KIV_UNIT, kav / KAV_UNIT, kbv / KPV_UNIT)
@@ -118,7 +169,8 @@ def tuned_gains(
         kfp=KFP_FULL if (position_loop and minimum_following_error) else 0,
         kav=_u16(kav / KAV_UNIT * factor) if position_loop else 0,
         kbv=_u16(kbv / KPV_UNIT * factor) if position_loop else 0,
-        speed_filter=0 if bandwidth_hz >= 75.0 else 1,
+        speed_filter=selected,
+        current_filters=filters,
     )
 
 

@@ -25,6 +25,12 @@ MODE_VELOCITY = 2
 MODE_TORQUE = 3
 MODE_FORCED_VECTOR = 4
 """Open-loop current vector at a forced electrical angle (phasing procedures)."""
+FORCED_Q_INTEGRAL = 40.0
+"""V/(A·s): the forced vector's q axis is voltage-driven with only this slow integral (≈ 1 Hz at 1.5 Ω), so the
+back-EMF of a rotor swinging about the field drives a braking current: electrical damping, whatever the phase
+order. The mean q current still returns to 0, so a steadily turning field is not braked."""
+FORCED_Q_RESISTANCE = 2.0
+"""V/A: a small proportional term (a virtual series resistance) bounds that braking current."""
 
 
 class ServoLoops:
@@ -122,9 +128,14 @@ class ServoLoops:
         error_q = iq_ref - i_q
         dt = self.dt
         vi_d = self._vi_d + self.ki_d * error_d * dt
-        vi_q = self._vi_q + self.ki_q * error_q * dt
         v_d = self.kp_d * error_d + vi_d
-        v_q = self.kp_q * error_q + vi_q + self.emf_constant * self.speed
+        if mode == MODE_FORCED_VECTOR:
+            # q in voltage mode with a slow integral: the rotor's back-EMF drives a braking current (damping)
+            vi_q = self._vi_q + FORCED_Q_INTEGRAL * error_q * dt
+            v_q = FORCED_Q_RESISTANCE * error_q + vi_q
+        else:
+            vi_q = self._vi_q + self.ki_q * error_q * dt
+            v_q = self.kp_q * error_q + vi_q + self.emf_constant * self.speed
         v_max = physics.dc_bus / 1.7320508075688772
         magnitude = math.sqrt(v_d * v_d + v_q * v_q)
         if magnitude > v_max:

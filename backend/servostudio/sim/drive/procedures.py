@@ -51,10 +51,10 @@ class PhasingResult:
 
 
 class ForcedVectorSweep:
-    """Common machinery: align, then sweep the forced angle and sample (angle, sensor turns)."""
+    """Common machinery: align, then sweep the forced angle and sample (angle, sensor turns, direction)."""
 
-    ALIGN_TIME = 0.3
-    ELECTRICAL_RATE = TWO_PI * 4.0  # rad/s of the forced angle
+    ALIGN_TIME = 0.6
+    ELECTRICAL_RATE = TWO_PI * 2.0  # rad/s of the forced angle
     RAMP_TIME = 0.2
 
     def __init__(self, dt: float, current: float) -> None:
@@ -62,8 +62,10 @@ class ForcedVectorSweep:
         self.current = current
         self.angle = 0.0
         self.time = 0.0
-        self.samples: list[tuple[float, float]] = []
+        self.samples: list[tuple[float, float, int]] = []
         self._rate = 0.0
+        self.steady_time = 0.0
+        """How long the sweep has turned at its full rate (the rotor's lag has settled after a while)."""
 
     def ramp_rate(self, direction: int) -> None:
         """Slew the sweep speed so the rotor is not kicked into oscillation."""
@@ -71,23 +73,39 @@ class ForcedVectorSweep:
         step = self.ELECTRICAL_RATE * self.dt / self.RAMP_TIME
         if abs(target - self._rate) <= step:
             self._rate = target
+            self.steady_time += self.dt
         else:
             self._rate += math.copysign(step, target - self._rate)
+            self.steady_time = 0.0
         self.angle += self._rate * self.dt
 
-    def sample(self, turns: float) -> None:
-        self.samples.append((self.angle, turns))
+    def sample(self, turns: float, direction: int) -> None:
+        self.samples.append((self.angle, turns, direction))
 
 
-def circular_offset(samples: list[tuple[float, float]], pole_pairs: int, phase_sign: int) -> tuple[float, float]:
-    """Offset in electrical turns (0..1) and the mean resultant length (1 = all samples agree)."""
-    x = y = 0.0
-    for angle, turns in samples:
-        value = TWO_PI * (phase_sign * angle / TWO_PI - pole_pairs * turns)
-        x += math.cos(value)
-        y += math.sin(value)
-    count = max(len(samples), 1)
-    return (math.atan2(y, x) / TWO_PI) % 1.0, math.hypot(x, y) / count
+def circular_offset(samples: list[tuple[float, float, int]], pole_pairs: int, phase_sign: int) -> tuple[float, float]:
+    """Offset in electrical turns (0..1) and the agreement (1 = all samples of each sweep agree).
+
+    The rotor lags the field by the same angle turning forward and backward (friction, the damping drag), so
+    the offset is the circular midpoint of the two sweeps' means; the agreement is the smaller mean resultant
+    length of the two sweeps (an oscillating or slipping rotor spreads its samples)."""
+    means = []
+    for direction in (1, -1):
+        x = y = 0.0
+        count = 0
+        for angle, turns, sweep in samples:
+            if sweep == direction:
+                value = TWO_PI * (phase_sign * angle / TWO_PI - pole_pairs * turns)
+                x += math.cos(value)
+                y += math.sin(value)
+                count += 1
+        if count:
+            means.append((math.atan2(y, x), math.hypot(x, y) / count))
+    if not means:
+        return 0.0, 0.0
+    first = means[0][0]
+    middle = first + sum(((m - first + math.pi) % TWO_PI - math.pi) for m, _ in means) / len(means)
+    return (middle / TWO_PI) % 1.0, min(r for _, r in means)
 
 
 class _SweepProcedure:
@@ -125,10 +143,13 @@ class _SweepProcedure:
     def _sweep_started(self, turns: float) -> None:
         """Hook: the alignment is over at sensor position `turns`."""
 
+    SETTLE_TIME = 0.0
+    """Samples are taken once the sweep has turned this long at its full rate."""
+
     def _ramp_and_sample(self, direction: int, turns: float) -> None:
         self.sweep.ramp_rate(direction)
-        if self._count % 8 == 0:
-            self.sweep.sample(turns)
+        if self._count % 8 == 0 and self.sweep.steady_time >= self.SETTLE_TIME:
+            self.sweep.sample(turns, direction)
 
     def _fail(self, reason: str) -> bool:
         self.failed_reason = reason
@@ -140,6 +161,8 @@ class AutoPhasing(_SweepProcedure):
     """'apha'. Drive it with `step(turns)`; read `angle`/`current` for the forced vector each period."""
 
     MAX_ELECTRICAL_TURNS = 26
+    SETTLE_TIME = 0.2
+    SAMPLE_TIME = 0.2
 
     def __init__(self, dt: float, current: float) -> None:
         super().__init__(dt, current)
@@ -158,10 +181,11 @@ class AutoPhasing(_SweepProcedure):
         if self._phase == "forward":
             self._ramp_and_sample(+1, turns)
             moved = turns - self._start_turns
-            if abs(moved) >= 1.0:
+            if abs(moved) >= 1.0 and not self._electrical_turns:
                 self._electrical_turns = sweep.angle / TWO_PI
                 self._direction = 1 if moved > 0 else -1
-                self._phase = "backward"
+            if self._electrical_turns and sweep.steady_time >= self.SETTLE_TIME + self.SAMPLE_TIME:
+                self._phase = "backward"  # one revolution seen and enough settled samples
             elif sweep.angle / TWO_PI > self.MAX_ELECTRICAL_TURNS:
                 return self._fail("the shaft did not follow the rotating field (blocked or loaded?)")
             return False

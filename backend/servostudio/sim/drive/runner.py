@@ -101,15 +101,22 @@ class ProcedureRunner:
             return MotorPhasing(drive.dt, current, drive.loops.pole_pairs, drive.loops.phase_sign)
         at_standstill = state is State.OPERATION_ENABLED and abs(drive.loops.speed) < 1.0
         if name == "atun" and (disabled or at_standstill) and not drive.brake_engaged():
-            return AutoTuning(drive.dt, current, float(drive.p.get("motor_torque_constant", 0)) * 1e-3)
+            return AutoTuning(drive.dt, current, self._torque_constant())
         return None
+
+    def _torque_constant(self) -> float:
+        """N·m/A from the motor data; a drive without a torque constant object (CD1-k) identifies per N·m/A."""
+        drive = self.drive
+        if not drive.has("motor_torque_constant"):
+            return 1.0
+        return float(drive.p.get("motor_torque_constant", 0)) * 1e-3
 
     def step(self) -> None:
         """One period of the running procedure, which owns the loops."""
         procedure = self.active
         loops = self.drive.loops
         if isinstance(procedure, AutoTuning):
-            finished = procedure.step(loops.speed, loops.i_q)
+            finished = procedure.step(loops.position, loops.speed, loops.i_q)
             loops.mode = MODE_TORQUE
             loops.current_ref = procedure.current_demand
         else:
@@ -170,7 +177,9 @@ class ProcedureRunner:
     def _apply_tuning(self, identified: Identified) -> None:
         drive = self.drive
         p = drive.p
-        bandwidth = gains.TUNING_BANDWIDTH_HZ.get(int(p.get("tuning_bandwidth", 1)), 75.0)
+        code, filter_type = self._tuning_codes()
+        bandwidth = gains.TUNING_BANDWIDTH_HZ.get(code, 75.0)
+        selection = int(p.get("tuning_speed_filter", 0))
         result = gains.tuned_gains(
             identified.inertia,
             identified.torque_constant,
@@ -178,6 +187,9 @@ class ProcedureRunner:
             position_loop=drive.active_mode != MODE_PV,
             minimum_following_error=int(p.get("tuning_requirement", 0)) == 0,
             viscous_friction=identified.viscous_friction,
+            speed_filter=None if selection == 0 else selection - 1,
+            anti_resonance=filter_type == 1,
+            resonance_hz=identified.resonance_hz,
         )
         for name, value in (
             ("kp_speed", result.kpv),
@@ -191,10 +203,30 @@ class ProcedureRunner:
             ("kf_position", result.kfp),
             ("ka_position", result.kav),
             ("kb_position", result.kbv),
+            ("speed_filter", result.speed_filter),
         ):
             drive.write(name, value)
-        selection = int(p.get("tuning_speed_filter", 0))
-        drive.write("speed_filter", result.speed_filter if selection == 0 else selection - 1)
-        corner = round(4.0 * bandwidth) if int(p.get("tuning_filter_type", 0)) == 1 else 0
-        for name in ("current_filter_1", "current_filter_2", "current_filter_3"):
+        filters = ("current_filter_1", "current_filter_2", "current_filter_3")
+        for name, corner in zip(filters, result.current_filters, strict=True):
             drive.write(name, corner)
+        self._publish_identified(identified)
+
+    def _tuning_codes(self) -> tuple[int, int]:
+        """(bandwidth 0..2, filter type 0..2): 0x3425,1 and ,2; the CD1-k codes both in 0x3420,1 (0..8)."""
+        p = self.drive.p
+        code = int(p.get("tuning_bandwidth", 1))
+        if self.drive.has("tuning_filter_type"):
+            return code, int(p.get("tuning_filter_type", 0))
+        return code % 3, code // 3
+
+    def _publish_identified(self, identified: Identified) -> None:
+        """0x3428 "Identified plant" (contract of issue #13); 0x3428,4 is the load's torque in the + direction."""
+        drive = self.drive
+        for name, value in (
+            ("identified_inertia", identified.inertia),
+            ("identified_viscous_friction", identified.viscous_friction),
+            ("identified_coulomb_friction", identified.coulomb_friction),
+            ("identified_load_torque", -identified.load_torque),
+            ("identified_residual", identified.residual),
+        ):
+            drive.write(name, value)

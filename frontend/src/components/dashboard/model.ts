@@ -122,7 +122,8 @@ export class DashboardModel {
     try {
       const answer = await driveApi.state(this.bus, this.node);
       live.updateAxis(this.bus, this.node, { online: true, nmt: answer.nmt_state });
-      this.nmt.val = `NMT ${answer.nmt_state ?? "unknown"}`;
+      // The node's own heartbeat state, else what its SDO answer proves (pre-operational or operational).
+      this.nmt.val = `NMT ${answer.nmt_text || (answer.nmt_state ?? "unknown")}`;
       this.applyStatusword(answer.statusword);
     } catch (error) {
       live.updateAxis(this.bus, this.node, { online: false });

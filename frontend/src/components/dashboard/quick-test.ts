@@ -1,8 +1,10 @@
 /**
- * Quick test · profile velocity (manual §1.8.19): acceleration, deceleration and target velocity in their units;
- * Set mode and run checks all three and hands them on, Stop writes target 0.
+ * Quick test (manual §1.8.19): profile velocity by its objects — acceleration, deceleration and target velocity in
+ * their units; Set mode and run checks all three and hands them on, Stop writes target 0 — and, with `motion`, the
+ * hold-to-run motions behind the arm switch: PV jog, PP moves, homing (`components/motion/`).
  */
 
+import { motionPanel, type MotionPanelProps } from "../motion/motion-panel";
 import { numberEditor, type ValueEditor } from "../editors";
 import { h, type Bindable } from "../../lib/dom";
 import type { Entry, Scalar } from "../../lib/od";
@@ -25,6 +27,8 @@ export interface QuickTestProps {
   onStop(): Promise<boolean>;
   /** A field's text was refused: `<name>: <reason>`. */
   onRefuse(message: string): void;
+  /** The hold-to-run jog, moves and homing of the axis. */
+  motion?: MotionPanelProps;
 }
 
 interface Field {
@@ -57,12 +61,13 @@ export function quickTest(props: QuickTestProps): HTMLElement {
     if (await props.onStop()) target.editor.revert();
   };
   return h("section", { class: "panel" },
-    h("h2", null, "Quick test · profile velocity"),
+    h("h2", null, props.motion ? "Quick test" : "Quick test · profile velocity"),
     h("div", { class: "panel-body grid", style: { gap: "8px" } },
       h("div", { class: "toolbar" }, fields.map(({ entry, label, editor }) =>
         h("label", { class: "field" }, `${label} [${entry.variable.unit}]`, editor.element))),
       h("div", { class: "toolbar" },
         h("button", { class: "primary", "data-testid": "qt-run", onclick: run }, "Set mode and run"),
         h("button", { "data-testid": "qt-stop", onclick: () => void stop() }, "Stop (target 0)"),
-        h("span", { class: "muted" }, "Runs only while the drive is in Operation enabled."))));
+        h("span", { class: "muted" }, "Runs only while the drive is in Operation enabled.")),
+      props.motion ? motionPanel(props.motion) : null));
 }

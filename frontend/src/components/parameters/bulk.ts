@@ -7,7 +7,8 @@ import type { ProjectParameter } from "../../client/api";
 import { confirmAction, errorText, toast } from "../ui";
 import { derive, h, state, untrack, type State } from "../../lib/dom";
 import { address, isReadable, type Entry, type Scalar } from "../../lib/od";
-import { unstorableReason } from "../../lib/values";
+import { formatValue, unstorableReason } from "../../lib/values";
+import { confirmChanges, type Change } from "../confirm/changes";
 import type { ParameterStore } from "./store";
 
 export interface BulkSources {
@@ -33,6 +34,8 @@ export class BulkActions {
   private readonly toDrive: State<Entry[]>;
   private readonly toProject: State<Entry[]>;
   private readonly explicit: State<Entry[]>;
+  /** Entries the project files set that the filter hides: Write changed → drive leaves them out. */
+  private readonly hidden: State<Entry[]>;
   /** Differences are known for the entries read so far; "+" says unread entries may add some (read on click). */
   private readonly more: State<string>;
 
@@ -40,10 +43,15 @@ export class BulkActions {
     private readonly store: ParameterStore,
     private readonly sources: BulkSources,
     private readonly shown: State<Entry[]>,
+    all: Entry[] = [],
   ) {
     this.toDrive = derive(() => store.toDrive(shown.val));
     this.toProject = derive(() => store.toProject(shown.val));
     this.explicit = derive(() => store.explicit(shown.val));
+    this.hidden = derive(() => {
+      const visible = new Set(shown.val);
+      return store.explicit(all).filter((entry) => !visible.has(entry));
+    });
     this.more = derive(() => (store.online.val && store.unread(shown.val).length > 0 ? "+" : ""));
     this.element = h("span", { class: "toolbar" }, () => {
       const running = this.running.val;
@@ -88,9 +96,12 @@ export class BulkActions {
     if (sources.drive && sources.project) {
       buttons.push(h("button", {
         disabled: () => offline() || (this.toDrive.val.length === 0 && !this.more.val), "data-testid": "param-write-changed",
-        title: "Write the project values that differ from the drive into the drive (unread entries are read first)",
+        title: "Write the shown project values that differ from the drive into the drive, after you confirmed the list"
+          + " (unread entries are read first; rows the filter hides are not written)",
         onclick: () => void this.writeToDrive(),
       }, () => `Write changed → drive (${this.toDrive.val.length}${this.more.val})`),
+      h("span", { class: "muted", "data-testid": "param-hidden-note" },
+        () => (this.hidden.val.length ? `shown rows only: the filter hides ${this.hidden.val.length} set values` : "")),
       h("button", {
         disabled: () => this.toProject.val.length === 0 && !this.more.val, "data-testid": "param-revert",
         title: "Take the drive values of the differing entries into the project (unread entries are read first)",
@@ -114,12 +125,14 @@ export class BulkActions {
   }
 
   private async writeToDrive(): Promise<void> {
-    if (!(await this.readMissing(this.shown.rawVal))) return;
+    // The hidden values the project sets are read too, so the confirmation can say how many of them differ.
+    if (!(await this.readMissing([...this.shown.rawVal, ...this.hidden.rawVal]))) return;
     const list = this.toDrive.rawVal;
     if (list.length === 0) {
       toast("The drive already holds every project value shown", "ok");
       return;
     }
+    if (!(await this.confirmWrite(list))) return;
     await this.run("Writing", list.length, async (signal, progress) => {
       const failures: string[] = [];
       for (const [position, entry] of list.entries()) {
@@ -138,6 +151,36 @@ export class BulkActions {
     });
   }
 
+  /** The list of what goes to the drive (drive value → project value), and what the filter keeps out of it. */
+  private confirmWrite(list: Entry[]): Promise<boolean> {
+    const changes: Change[] = list.map((entry) => ({
+      address: address(entry), name: entry.variable.name,
+      old: shownValue(entry, this.store.driveCell(entry.key).rawVal?.raw), new: shownValue(entry, this.store.projectRow(entry.key).rawVal?.value),
+    }));
+    const hidden = this.hidden.rawVal;
+    const differing = this.store.toDrive(hidden).length;
+    const notes = hidden.length
+      ? [`The filter hides ${hidden.length} more entries the project sets${differing ? ` (${differing} of them differ from the drive)` : ""}: they are not written. Clear the search and the group to write them too.`]
+      : ["Every entry the project sets is shown: nothing is hidden by the filter."];
+    return confirmChanges({
+      title: "Write changed values to the drive", confirm: `Write ${list.length} to the drive`, danger: true, changes, notes,
+      text: `Write ${list.length} project values into the drive? The drive acts on each at once (drive value → project value):`,
+    });
+  }
+
+  /** The project values Drive → project replaces (project value → drive value). */
+  private confirmTake(list: Entry[]): Promise<boolean> {
+    const changes: Change[] = list.map((entry) => ({
+      address: address(entry), name: entry.variable.name,
+      old: shownValue(entry, this.store.projectRow(entry.key).rawVal?.value), new: shownValue(entry, this.store.driveCell(entry.key).rawVal?.raw),
+    }));
+    return confirmChanges({
+      title: "Take drive values into the project", confirm: `Store ${list.length} in the project`, changes, folded: list.length > 20,
+      text: `Store ${list.length} drive values in the project (project value → drive value)?`,
+      notes: ["The project as it is now is kept as a revision: the backup page can restore it."],
+    });
+  }
+
   private async driveToProject(): Promise<void> {
     if (!(await this.readMissing(this.shown.rawVal))) return;
     const list = this.toProject.rawVal;
@@ -145,6 +188,7 @@ export class BulkActions {
       toast("The project already holds every drive value shown", "ok");
       return;
     }
+    if (!(await this.confirmTake(list))) return;
     await this.run("Storing", list.length, async (_signal, progress) => {
       const candidates = list.map((entry) => ({ entry, raw: this.store.driveCell(entry.key).rawVal!.raw }));
       const changes = candidates.filter((change): change is { entry: Entry; raw: number | string } =>
@@ -165,6 +209,10 @@ export class BulkActions {
       progress(list.length);
     });
   }
+}
+
+function shownValue(entry: Entry, raw: Scalar | undefined): string {
+  return `${formatValue(entry.variable, raw ?? null)} ${entry.variable.unit}`.trim();
 }
 
 function progressView(running: BulkProgress): (Node | string)[] {

@@ -36,7 +36,7 @@ function detailBody(entry: Entry, context: DetailContext): HTMLElement {
   const canDrive = derive(() => context.hasDrive && store.online.val && isWritable(variable.access));
   const canProject = derive(() => context.hasProject && Boolean(project.val?.editable));
   const shownValue = (): Scalar => drive.val?.raw ?? project.val?.value ?? null;
-  const { section: editorSection, editor } = writeSection(entry, context, canDrive, canProject);
+  const { section: editorSection, editor, holds } = writeSection(entry, context, canDrive, canProject);
   const withEditor = (build: (editor: ValueEditor | null) => HTMLElement) => () => {
     const current = editor.val;
     return untrack(() => build(current));
@@ -45,7 +45,7 @@ function detailBody(entry: Entry, context: DetailContext): HTMLElement {
     h("div", { class: "mono muted" }, `${address(entry)}  ·  ${entry.object.name}`),
     h("h3", { "data-testid": "detail-name" }, variable.name),
     variable.description ? h("div", { class: "desc" }, variable.description) : null,
-    h("section", null, valuesTable(entry, context)),
+    h("section", null, valuesTable(entry, context, () => (editor.val ? holds.val : null))),
     editorSection,
     variable.bits.length ? withEditor((current) => bitFields(variable, shownValue, current)) : null,
     Object.keys(variable.enum).length ? enumList(variable, shownValue) : null,
@@ -54,11 +54,12 @@ function detailBody(entry: Entry, context: DetailContext): HTMLElement {
   );
 }
 
-function kv(label: string, value: Node | string | (() => Node | string)): HTMLElement {
+function kv(label: Node | string | (() => Node | string), value: Node | string | (() => Node | string)): HTMLElement {
   return h("tr", null, h("td", null, label), h("td", null, value));
 }
 
-function valuesTable(entry: Entry, context: DetailContext): HTMLElement {
+/** Drive and project value side by side; the one the editor's field holds is marked. */
+function valuesTable(entry: Entry, context: DetailContext, holds: () => "drive" | "project" | null): HTMLElement {
   const variable = entry.variable;
   const drive = context.store.driveCell(entry.key);
   const project = context.store.projectRow(entry.key);
@@ -76,9 +77,11 @@ function valuesTable(entry: Entry, context: DetailContext): HTMLElement {
     return h("span", { class: "mono", "data-testid": "detail-project-value" }, withUnit(row.value),
       h("span", { class: "muted" }, row.file ? ` (${row.file})` : " (default)"));
   };
+  const label = (side: "drive" | "project", text: string) => () =>
+    h("span", { "data-testid": `detail-${side}-label` }, text, holds() === side ? h("span", { class: "muted" }, " ◂ field") : null);
   return h("table", { class: "kv" }, h("tbody", null,
-    context.hasDrive ? kv("Drive", driveValue) : null,
-    context.hasProject ? kv("Project", projectValue) : null));
+    context.hasDrive ? kv(label("drive", "Drive"), driveValue) : null,
+    context.hasProject ? kv(label("project", "Project"), projectValue) : null));
 }
 
 function facts(entry: Entry): HTMLElement {

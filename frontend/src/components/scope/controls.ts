@@ -80,7 +80,15 @@ function timingRow(model: ScopeModel): HTMLElement {
     h("label", null, "Samples ", textField(draft.samples, "scope-samples", "80px")),
     h("label", null, "Mode ", choice(draft.mode, ["single", "normal", "auto"], "scope-mode")),
     () => draft.mode.val === "auto" ? h("label", null, "forced after ", textField(draft.autoTimeout, "scope-auto-timeout", "60px"), " ms") : null,
-    h("span", { class: "muted" }, () => model.info.val ? `buffer ${model.info.val.capacity} bytes, ${model.info.val.channels} channels` : ""));
+    h("span", { class: "muted" }, () => sourceText(model.info.val)));
+}
+
+/** What takes the samples: the drive's recorder, TPDOs at the server's SYNC, or SDO polling (docs/scope.md §7). */
+function sourceText(info: ScopeModel["info"]["val"]): string {
+  if (!info) return "";
+  if (info.source === "recorder") return `recorder: buffer ${info.capacity ?? 0} bytes, ${info.channels} channels`;
+  if (info.source === "tpdo") return `no recorder: TPDOs at the server's SYNC (every ${info.base_period_ns / 1e6} ms at the fastest), ${info.channels} channels`;
+  return "no recorder, no TPDO: polled by SDO (the plan states the rate)";
 }
 
 function triggerRow(model: ScopeModel, index: Searchable[]): HTMLElement {

@@ -126,6 +126,7 @@ export function request(draft: Draft): CaptureRequest {
     pre_trigger_pct: source ? number(draft.pretrigger.rawVal, "Pre-trigger") : 0,
     mode: draft.mode.rawVal,
     auto_timeout_ms: number(draft.autoTimeout.rawVal, "Auto timeout"),
+    source: "auto",
   };
 }
 

@@ -37,6 +37,7 @@ from servostudio.services.projects.axisvalues import AxisValues
 from servostudio.services.projects.errors import ConflictError, ProjectError, ValidationError
 from servostudio.services.projects.live.links import AxisLink, link_axes
 from servostudio.services.projects.parameter_values import to_file_value
+from servostudio.services.projects.revisions import keeping
 from servostudio.services.projects.service import ProjectService
 
 log = logging.getLogger(__name__)
@@ -230,7 +231,8 @@ def _install(
     """Replace the uploaded axes' files in one project change (refused if the project changed meanwhile)."""
     if not reports:
         return service.store.open(project).revision
-    with service.store.edit(project, expected_revision) as edit:
+    kept = "upload of the drives into the project"  # the project as it was stays restorable (docs/projects.md §3)
+    with service.store.edit(project, expected_revision) as edit, keeping(edit, kept):
         for report in reports:  # the revision check above guarantees the axes are the ones identified
             axis = report.link.axis
             try:

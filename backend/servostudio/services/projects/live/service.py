@@ -39,6 +39,7 @@ class LiveProjects:
         group: str | None = None,
         only_differences: bool = False,
         buses: Mapping[str, str] | None = None,
+        read_only: bool = False,
     ) -> LiveCompare:
         return compare_with_drive(
             self.projects.parameters,
@@ -46,6 +47,7 @@ class LiveProjects:
             self.link(project, axis, buses),
             group=group,
             only_differences=only_differences,
+            read_only=read_only,
         )
 
     def take(

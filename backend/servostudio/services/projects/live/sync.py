@@ -32,6 +32,7 @@ class LiveCompare:
     rows: list[CompareRow]
     revision: str
     refused: dict[str, str]  # objects the drive refused to read: address -> reason
+    read_only: list[CompareRow] = field(default_factory=list)  # asked for: read-only entries, not counted
 
 
 def compare_with_drive(
@@ -41,14 +42,19 @@ def compare_with_drive(
     *,
     group: str | None = None,
     only_differences: bool = False,
+    read_only: bool = False,
 ) -> LiveCompare:
-    """Columns drive / project / default; all drive reads are queued at once."""
-    source = DriveValues(link.drive(), parameters.transferable(project, link.axis.name, group))
-    rows, revision = parameters.compare(
-        project, link.axis.name, group=group, only_differences=only_differences, drive=source
-    )
+    """Columns drive / project / default; all drive reads are queued at once. With ``read_only`` the read-only
+    entries are read too and given apart (they are never counted as differences: nobody can write them)."""
+    axis = link.axis.name
+    variables = parameters.transferable(project, axis, group)
+    if read_only:
+        variables += parameters.read_only_variables(project, axis, group)
+    source = DriveValues(link.drive(), variables)
+    rows, revision = parameters.compare(project, axis, group=group, only_differences=only_differences, drive=source)
+    apart = parameters.read_only(project, axis, group=group, drive=source) if read_only else []
     refused = {f"0x{index:04X},{sub}": reason for (index, sub), reason in source.refused.items()}
-    return LiveCompare(rows, revision, refused)
+    return LiveCompare(rows, revision, refused, apart)
 
 
 def take_from_drive(
@@ -76,7 +82,8 @@ def take_from_drive(
     if missing:
         reasons = "; ".join(f"{v.label}: {refused.get(address_of(v), 'no value')}" for v in missing[:5])
         raise ParameterRefused(f"the drive gave no value for {len(missing)} object(s) ({reasons}); nothing was taken")
-    return parameters.set(project, axis, {address_of(v): value for v, value in chosen.items()}, expected_revision)
+    changes = {address_of(v): value for v, value in chosen.items()}
+    return parameters.set(project, axis, changes, expected_revision, keep=f"drive values of axis {axis} taken")
 
 
 @dataclass

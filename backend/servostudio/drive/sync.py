@@ -1,0 +1,81 @@
+"""The server's SYNC producer on one bus (CiA 301 SYNC: COB-ID 0x080, no data), for captures through TPDOs.
+
+Each drive samples its synchronous TPDOs when the SYNC frame reaches it, and every drive of the bus receives the
+same frame at the same instant: that is what aligns the channels of several axes. The producer runs on a thread
+of its own and schedules each frame from the first one (``start + k × period``), so a late frame does not delay
+the ones after it; every send instant is noted, and `jitter_ns` says how far the frames were from that schedule.
+
+With ``answered`` (how many SYNCs the consumers have seen the answers of) the producer stays at most
+``MAX_AHEAD`` SYNCs ahead of them: a bus that cannot carry the answers in time (or a simulated bus behind real
+time) then gets its SYNCs later — which the jitter states — instead of a backlog that starves every frame of
+lower priority (SDO included) for good.
+"""
+
+from __future__ import annotations
+
+import threading
+import time
+from collections.abc import Callable
+
+from servostudio.drive.link import BusLink, LinkDownError
+
+SYNC_COB_ID = 0x080
+#: the shortest period offered: a Python thread on a loaded host keeps 1 ms to a fraction of it, not 100 µs
+MIN_PERIOD_S = 1e-3
+#: SYNCs sent whose answers have not all arrived, at most (the answers of one are on the bus while the next leaves)
+MAX_AHEAD = 2
+#: how often a producer held back by its consumers looks again
+HOLD_SECONDS = 2e-4
+
+
+class SyncProducer:
+    """SYNC frames every ``period_s`` until stopped (or a lost link ends them)."""
+
+    def __init__(self, link: BusLink, period_s: float, answered: Callable[[], int] | None = None) -> None:
+        if period_s < MIN_PERIOD_S:
+            raise ValueError(f"SYNC period {period_s * 1e6:.0f} µs below {MIN_PERIOD_S * 1e6:.0f} µs")
+        self.link = link
+        self.period_s = period_s
+        self.sent: list[float] = []  # monotonic send instants
+        self.error: str | None = None
+        self._answered = answered
+        self._stop = threading.Event()
+        self._thread = threading.Thread(target=self._run, name=f"sync {link.name}", daemon=True)
+
+    def start(self) -> SyncProducer:
+        self._thread.start()
+        return self
+
+    def stop(self) -> None:
+        self._stop.set()
+        if self._thread.is_alive() and self._thread is not threading.current_thread():
+            self._thread.join(5.0)
+
+    @property
+    def count(self) -> int:
+        return len(self.sent)
+
+    def jitter_ns(self) -> int:
+        """The largest distance of a SYNC from its scheduled instant (the first frame's time + k × period)."""
+        if not self.sent:
+            return 0
+        first = self.sent[0]
+        return round(max(abs(t - first - k * self.period_s) for k, t in enumerate(self.sent)) * 1e9)
+
+    def _run(self) -> None:
+        start = time.monotonic()
+        k = 0
+        while not self._stop.is_set():
+            delay = start + k * self.period_s - time.monotonic()
+            if delay > 0 and self._stop.wait(delay):
+                return
+            while self._answered is not None and k - self._answered() >= MAX_AHEAD:
+                if self._stop.wait(HOLD_SECONDS):
+                    return
+            try:
+                self.link.send(SYNC_COB_ID, b"")
+            except LinkDownError as error:
+                self.error = str(error)
+                return
+            self.sent.append(time.monotonic())
+            k += 1

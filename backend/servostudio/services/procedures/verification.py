@@ -1,0 +1,224 @@
+"""The verification after auto-tuning (docs/commissioning.md §5): a speed step, and in minimum-overshoot mode a
+position step, recorded with the capture service while the axis is enabled through the motion guard (the run's
+actor is the axis's armed controller), then disabled again with every value it changed put back.
+
+The step is small enough that the current stays below its limit (a saturated loop says nothing about its
+bandwidth): Δω = ½ of the rated current's torque over J·ω of the requested bandwidth, from the identified inertia
+and the torque constant. It starts from a small base speed, not from rest (Coulomb friction, see BASE_SHARE). A
+drive without a recorder gets no verification (``skipped`` says why).
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable, Mapping
+from typing import TYPE_CHECKING, Any
+
+from servostudio.drive.access import Drive
+from servostudio.drive.cia402 import State
+from servostudio.drive.control import set_state
+from servostudio.services.procedures.commutation import verify_commutation
+from servostudio.services.procedures.recording import record
+from servostudio.services.procedures.run import disable, read_values, restore
+from servostudio.services.procedures.stepmetrics import step_metrics
+from servostudio.services.procedures.units import TWO_PI, speed_rad_s, units_per_revolution, user_speed
+from servostudio.services.scope import Capture, CaptureDefinition, Trigger
+
+if TYPE_CHECKING:
+    from servostudio.services.procedures.run import ProcedureRun
+
+MODE_PP, MODE_PV = 1, 3
+PERIOD_US = 500.0
+SAMPLES = 800  # 0.4 s: a slow loop (anti-resonance filter) settles within it
+PRE_TRIGGER_PCT = 5.0
+#: the ramps of a step: a fraction of a second to full speed is a step for a loop of 50 Hz and more
+STEP_RAMP_REV_S2 = 20000.0
+SETTLE_S = 0.2
+RETURN_WAIT = 3.0
+POSITION_STEP_REV = 0.05
+DEFAULT_STEP_RAD_S = 5.0
+#: the step's travel over the recording stays below a revolution (the manual: one free revolution)
+MAX_STEP_RAD_S = 9.0
+#: the step's current: the larger the step, the smaller the speed measurement's quantisation next to it
+STEP_CURRENT_SHARE = 0.5
+#: the step starts from this share of its size in speed, never from standstill: Coulomb friction changes sign
+#: at zero speed, which makes a step from rest a load step too (measured: 0.64-0.75 x the loop's bandwidth)
+BASE_SHARE = 0.25
+RPM = 60.0 / TWO_PI
+
+
+def verify(run: ProcedureRun, result: dict[str, object], options: Mapping[str, Any]) -> dict[str, object] | None:
+    """The verification of a procedure that has one; None for the others."""
+    if run.name == "auto_phasing":
+        run.progress("verifying", "done", "verification: commutation (torque per ampere)", None)
+        return verify_commutation(run.drive)
+    if run.name != "auto_tuning":
+        return None
+    drive = run.drive
+    if drive.profile.recorder is None:
+        return {"speed_step": None, "position_step": None, "skipped": f"the {drive.profile.device} has no recorder"}
+    run.progress("verifying", "done", "verification: speed step", None)
+    saved = read_values(drive, list(drive.profile.procedures.verification_objects))
+    start = int(drive.read("position_actual").raw)
+    try:
+        speed = _speed_step(drive, _step_size(drive, result, options))
+        position = _position_step(drive) if options.get("mode") == "min-overshoot" else None
+        _back_to(drive, start)
+    finally:
+        disable(drive)
+        restore(drive, saved)
+    return {"speed_step": speed, "position_step": position}
+
+
+def _step_size(drive: Drive, result: dict[str, object], options: Mapping[str, Any]) -> float:
+    """rad/s of the speed step."""
+    identified = result.get("identified")
+    inertia = identified.get("inertia_kgm2") if isinstance(identified, dict) else None
+    name = drive.profile.procedures.torque_constant
+    if not isinstance(inertia, float) or inertia <= 0 or name is None or not drive.profile.has("rated_current"):
+        return DEFAULT_STEP_RAD_S
+    torque_constant = float(drive.read(name).physical)
+    current = float(drive.read("rated_current").physical)
+    omega = TWO_PI * float(options.get("bandwidth", 75))
+    step = STEP_CURRENT_SHARE * current * torque_constant / (inertia * omega)
+    return min(max(step, 1.0), MAX_STEP_RAD_S) if step > 0 else DEFAULT_STEP_RAD_S
+
+
+def _speed_step(drive: Drive, step_rad_s: float) -> dict[str, object]:
+    """Profile velocity, enabled at standstill, then the target jumps; the recording gives the metrics."""
+    ramp = units_per_revolution(drive) * STEP_RAMP_REV_S2
+    base = round(user_speed(drive, BASE_SHARE * step_rad_s))
+    target = base + round(user_speed(drive, step_rad_s))
+    values = {"target_velocity": base, "profile_acceleration": ramp, "profile_deceleration": ramp}
+    _prepare(drive, MODE_PV, values | _speed_limit(drive, 2 * abs(target)))
+    definition = CaptureDefinition(
+        channels=("target_velocity", "velocity_actual"),
+        period_us=PERIOD_US,
+        samples=SAMPLES,
+        trigger=Trigger("target_velocity", "rising" if target > 0 else "falling", (base + target) / 2),
+        pre_trigger_pct=PRE_TRIGGER_PCT,
+        timeout_s=10.0,
+    )
+    capture = _record(drive, definition, lambda: drive.write("target_velocity", target),
+                      lambda: drive.write("target_velocity", 0))  # fmt: skip
+    times = capture.times_s()
+    rpm = speed_rad_s(drive, 1.0) * RPM  # one user unit/s in rpm
+    reference = [float(value) * rpm for value in capture.physical(0)]
+    response = [float(value) * rpm for value in capture.physical(1)]
+    metrics = step_metrics(times, reference, response, _measurement_filters(drive))
+    return {**metrics.as_dict(), "capture": _shown(times, reference, response, "rpm")}
+
+
+def _position_step(drive: Drive) -> dict[str, object]:
+    """Profile position: a small relative move at a speed and ramps far beyond the loop's; overshoot of the
+    actual position past the target."""
+    disable(drive)
+    units = units_per_revolution(drive)
+    ramp = units * STEP_RAMP_REV_S2
+    values = {"profile_velocity": units * 50, "profile_acceleration": ramp, "profile_deceleration": ramp}
+    _prepare(drive, MODE_PP, values | _speed_limit(drive, units * 50))
+    start = float(drive.read("position_actual").raw)
+    distance = round(units * POSITION_STEP_REV)
+    definition = CaptureDefinition(
+        channels=("position_demand", "position_actual"),
+        period_us=PERIOD_US,
+        samples=SAMPLES,
+        trigger=Trigger("position_demand", "rising", start + distance / 2),
+        pre_trigger_pct=PRE_TRIGGER_PCT,
+        timeout_s=10.0,
+    )
+    capture = _record(drive, definition, lambda: _move(drive, distance), lambda: None)
+    times = capture.times_s()
+    reference = [float(value) - start for value in capture.physical(0)]
+    response = [float(value) - start for value in capture.physical(1)]
+    metrics = step_metrics(times, reference, response)
+    return {**metrics.as_dict(), "capture": _shown(times, reference, response, "user position units")}
+
+
+def _back_to(drive: Drive, start: int) -> None:
+    """Profile position back to where the verification started (the tuned loop holds it), within a second."""
+    disable(drive)
+    units = units_per_revolution(drive)
+    values = {"profile_velocity": units, "profile_acceleration": units * 20, "profile_deceleration": units * 20}
+    _prepare(drive, MODE_PP, values | _speed_limit(drive, units))
+    drive.write("target_position", start)
+    drive.write("controlword", 0x0F | 0x10 | 0x20)
+    drive.write("controlword", 0x0F | 0x20)
+    deadline = time.monotonic() + RETURN_WAIT
+    while time.monotonic() < deadline and abs(int(drive.read("position_actual").raw) - start) > units / 100:
+        time.sleep(0.02)
+
+
+def _prepare(drive: Drive, mode: int, values: Mapping[str, float]) -> None:
+    writes = [(drive.variable("modes_of_operation"), mode)]
+    writes += [(drive.variable(name), _fit(drive, name, value)) for name, value in values.items()]
+    drive.submit_write_all(writes).future.result()
+    set_state(drive, State.OPERATION_ENABLED)
+    time.sleep(SETTLE_S)
+
+
+def _speed_limit(drive: Drive, needed: float) -> dict[str, float]:
+    """Raise the profile's speed limit (0x607F) to what the step needs, if it is lower (put back afterwards)."""
+    if not drive.profile.has("max_profile_velocity"):
+        return {}
+    present = float(drive.read("max_profile_velocity").raw)
+    return {} if present >= needed else {"max_profile_velocity": needed}
+
+
+def _fit(drive: Drive, name: str, value: float) -> int:
+    """A ramp or speed within its object's range."""
+    high = drive.variable(name).high
+    return int(min(value, high)) if high is not None else int(value)
+
+
+def _move(drive: Drive, distance: int) -> None:
+    """A relative set-point taken at once (control word bits 4 new set-point, 5 change at once, 6 relative)."""
+    drive.write("target_position", distance)
+    drive.write("controlword", 0x0F | 0x10 | 0x20 | 0x40)
+    drive.write("controlword", 0x0F | 0x20 | 0x40)
+
+
+def _record(
+    drive: Drive, definition: CaptureDefinition, act: Callable[[], object], done: Callable[[], object]
+) -> Capture:
+    """Act once the recorder waits for its trigger (a trigger while it fills its pre-trigger samples would be
+    missed), end the step once the recording is complete, and read it."""
+
+    def report(event: dict[str, object]) -> None:
+        if event.get("stage") == "waiting":
+            act()
+        elif event.get("stage") == "done":
+            done()
+
+    return record(drive, definition, report)
+
+
+def _measurement_filters(drive: Drive) -> tuple[float, ...]:
+    """The cut-offs (Hz) of the first-order filters between the shaft's speed and the recorded 0x606C."""
+    return tuple(value for value in (_monitor_filter(drive), _loop_speed_filter(drive)) if value is not None)
+
+
+def _monitor_filter(drive: Drive) -> float | None:
+    name = drive.profile.procedures.speed_monitor_filter
+    if name is None or not drive.profile.has(name):
+        return None
+    value = float(drive.read(name).physical)
+    return value if value > 0 else None
+
+
+def _loop_speed_filter(drive: Drive) -> float | None:
+    procedures = drive.profile.procedures
+    name = procedures.speed_measurement_filter
+    if name is None or not drive.profile.has(name):
+        return None
+    tau = procedures.speed_measurement_filter_s.get(int(drive.read(name).raw))
+    return 1.0 / (TWO_PI * tau) if tau else None
+
+
+def _shown(times: list[float], reference: list[float], response: list[float], unit: str) -> dict[str, object]:
+    return {
+        "time_s": [round(value, 6) for value in times],
+        "reference": [round(value, 3) for value in reference],
+        "response": [round(value, 3) for value in response],
+        "unit": unit,
+    }
