@@ -15,6 +15,7 @@ from starlette.testclient import WebSocketDenialResponse
 from tests.support.access import admin_app, bearer, token
 
 from servostudio.api.routes.events import EVENT_MESSAGES, TERMINAL_MESSAGES
+from servostudio.api.routes.scope import ROLL_MESSAGES
 from servostudio.api.security import declared_levels
 from servostudio.services.settings import Settings
 from servostudio.services.users import Level
@@ -129,15 +130,18 @@ def test_without_credentials_only_the_public_routes_answer(app, client):
     assert not problems, "\n".join(problems)
 
 
-@pytest.mark.parametrize("path", ["/api/ws/events", "/api/ws/terminal"])
-def test_websockets_need_a_caller_of_their_level(app, client, tokens, path):
+@pytest.mark.parametrize(
+    ("path", "url"),
+    [("/api/ws/events",) * 2, ("/api/ws/terminal",) * 2, ("/api/ws/scope/{roll}", "/api/ws/scope/no-roll")],
+)
+def test_websockets_need_a_caller_of_their_level(app, client, tokens, path, url):
     route = next(route for route in api_routes(app) if route.path == path)
     assert declared_levels(route) == [Level.OPERATOR]
-    with pytest.raises(WebSocketDenialResponse) as denied, client.websocket_connect(path):
+    with pytest.raises(WebSocketDenialResponse) as denied, client.websocket_connect(url):
         pass
     assert denied.value.status_code == 401 and denied.value.json()["kind"] == "unauthenticated"
     for text in tokens.values():
-        with client.websocket_connect(path, headers=bearer(text)):
+        with client.websocket_connect(url, headers=bearer(text)):
             pass
 
 
@@ -152,6 +156,8 @@ def test_every_terminal_message_has_a_level_and_is_checked_per_level(client, tok
     assert set(TERMINAL_MESSAGES) == set(TERMINAL_REQUESTS)
     # the event socket's one client message, the hold-to-run keepalive (tests/api/test_motion_quick_test.py checks it)
     assert EVENT_MESSAGES == {"keepalive": Level.MAINTENANCE}
+    # the roll socket's one client message, its stop (every level that may roll may stop it: Operator)
+    assert ROLL_MESSAGES == {"stop": Level.OPERATOR}
     for level, text in tokens.items():
         with client.websocket_connect("/api/ws/terminal", headers=bearer(text)) as socket:
             for operation, request in TERMINAL_REQUESTS.items():

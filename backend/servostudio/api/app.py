@@ -30,6 +30,8 @@ from servostudio.api.routes import (
     projects,
     scope,
     sequences,
+    server,
+    speed_loop,
     users,
 )
 from servostudio.api.security import BrowserOrigin, OriginPolicy
@@ -74,6 +76,8 @@ def create_app(settings: Settings | None = None) -> FastAPI:
         sequences,
         events,
         audit,
+        server,
+        speed_loop,
     ):
         app.include_router(router.router, prefix="/api")
     mount_ui(app, state.settings.static_dir)

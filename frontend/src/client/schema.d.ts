@@ -117,7 +117,11 @@ export interface paths {
         };
         get?: never;
         put?: never;
-        /** Send an NMT command */
+        /**
+         * Send an NMT command
+         * @description Judged by the motion guard for every node it reaches and logged as writes are: a start of an enabled axis
+         *     needs its armed controller (409 otherwise); a reset of an enabled axis is a stop (docs/motion-safety.md).
+         */
         post: operations["nmt_api_buses__bus__nmt_post"];
         delete?: never;
         options?: never;
@@ -573,6 +577,23 @@ export interface paths {
         patch?: never;
         trace?: never;
     };
+    "/api/buses/{bus}/nodes/{node}/scope/roll": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        get?: never;
+        put?: never;
+        /** Live roll mode: stream up to 4 channels per axis through TPDOs at the server's SYNC (the bus budget is checked first: 422 when over-subscribed); the samples on the WebSocket the answer names */
+        post: operations["start_roll_api_buses__bus__nodes__node__scope_roll_post"];
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
     "/api/buses/{bus}/nodes/{node}/scope/status": {
         parameters: {
             query?: never;
@@ -752,6 +773,24 @@ export interface paths {
          * @description ``sseq``: the sequence memory into the drive's SEQUENCE.TXT.
          */
         post: operations["store_api_buses__bus__nodes__node__sequences_store_post"];
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
+    "/api/buses/{bus}/nodes/{node}/speed-loop": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        /** The speed-loop gains and filters in physical units */
+        get: operations["get_speed_loop_api_buses__bus__nodes__node__speed_loop_get"];
+        /** Write speed-loop gains and filters given in physical units (all checked before any write) */
+        put: operations["put_speed_loop_api_buses__bus__nodes__node__speed_loop_put"];
+        post?: never;
         delete?: never;
         options?: never;
         head?: never;
@@ -1615,6 +1654,23 @@ export interface paths {
          * @description Every type's keywords: 0x3611 sub, unit, allowed values, default (the editor's fields).
          */
         get: operations["keywords_api_sequences_keywords_get"];
+        put?: never;
+        post?: never;
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
+    "/api/server/settings": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        /** What the server was started with (read-only; no secrets) */
+        get: operations["get_settings_api_server_settings_get"];
         put?: never;
         post?: never;
         delete?: never;
@@ -3762,6 +3818,56 @@ export interface components {
              */
             revision?: string | null;
         };
+        /**
+         * RollModel
+         * @description A roll started: its job (``scope-roll``), the plan with the bus budget, and the WebSocket of its samples.
+         */
+        RollModel: {
+            job: components["schemas"]["JobModel"];
+            plan: components["schemas"]["PlanModel"];
+            /**
+             * Socket
+             * @description GET as WebSocket: the roll's samples, gaps and end (docs/scope.md §8)
+             */
+            socket: string;
+        };
+        /**
+         * RollRequest
+         * @description Live roll mode: up to 4 channels per axis (``OBJ@NODE`` for another axis of the bus) through synchronous
+         *     TPDOs at the server's SYNC; the bus budget is checked before anything is armed (422 when over-subscribed).
+         * @example {
+         *       "channels": [
+         *         "0x6064,0",
+         *         "0x606C,0"
+         *       ],
+         *       "period_us": 1000,
+         *       "record": true
+         *     }
+         */
+        RollRequest: {
+            /**
+             * Channels
+             * @description objects by address or name
+             */
+            channels: string[];
+            /**
+             * Period Us
+             * @description the SYNC period: 1000 µs (1 kHz) at the fastest
+             * @default 1000
+             */
+            period_us: number;
+            /**
+             * Record
+             * @description keep every sample (up to the first gap) as a capture at the end
+             * @default false
+             */
+            record: boolean;
+            /**
+             * Seconds
+             * @description roll this long; none: until stopped
+             */
+            seconds?: number | null;
+        };
         /** RunModel */
         RunModel: {
             /** Node */
@@ -3952,6 +4058,72 @@ export interface components {
              */
             text: string;
         };
+        /** ServerSettingsModel */
+        ServerSettingsModel: {
+            /**
+             * Allowed Hosts
+             * @description Host values accepted besides the loopback names (`--allowed-host`)
+             */
+            allowed_hosts: string[];
+            /**
+             * Allowed Origins
+             * @description browser origins accepted besides the server's own
+             */
+            allowed_origins: string[];
+            /**
+             * Audit File
+             * @description the audit log the server appends to
+             */
+            audit_file: string;
+            /** Builtin Eds Dir */
+            builtin_eds_dir: string;
+            /**
+             * Buses
+             * @description bus specs opened at start (`--bus`); credentials in a URL masked
+             */
+            buses: string[];
+            /**
+             * Data Dir
+             * @description users, tokens and the audit log (`--data-dir`, `SERVOSTUDIO_DATA_DIR`)
+             */
+            data_dir: string;
+            /**
+             * Export Dir
+             * @description where backup and restore jobs may also write (`--export-dir`)
+             */
+            export_dir: string | null;
+            /**
+             * Host
+             * @description the address the server listens on (`serve --host`)
+             */
+            host: string;
+            /** Motors Dir */
+            motors_dir: string;
+            /**
+             * Passwordless
+             * @description the password-less single-user mode chosen at setup
+             */
+            passwordless: boolean;
+            /** Port */
+            port: number;
+            /**
+             * Projects Dir
+             * @description the project store (`--projects`)
+             */
+            projects_dir: string;
+            /**
+             * Shares
+             * @description buses shared as socketcand endpoints at start (`--share BUS=PORT`)
+             */
+            shares: string[];
+            /**
+             * User Eds Dir
+             * @description where imported EDS files go
+             */
+            user_eds_dir: string;
+            /** Version */
+            version: string;
+        };
         /** SettingModel */
         SettingModel: {
             /** Index */
@@ -4054,6 +4226,100 @@ export interface components {
              * @default 0
              */
             port: number;
+        };
+        /**
+         * SpeedLoopChange
+         * @description Physical values to write; keys left out keep their values.  The drive's `writable` says which it takes.
+         */
+        SpeedLoopChange: {
+            /** Current Filter 1 Hz */
+            current_filter_1_hz?: number | null;
+            /** Current Filter 2 Hz */
+            current_filter_2_hz?: number | null;
+            /** Current Filter 3 Hz */
+            current_filter_3_hz?: number | null;
+            /** Ka A Per Rad S2 */
+            ka_a_per_rad_s2?: number | null;
+            /** Kb A Per Rad S */
+            kb_a_per_rad_s?: number | null;
+            /** Kc A Per Rad S */
+            kc_a_per_rad_s?: number | null;
+            /** Kd A Per Rad S2 */
+            kd_a_per_rad_s2?: number | null;
+            /** Kd Filter Hz */
+            kd_filter_hz?: number | null;
+            /** Ki A Per Rad */
+            ki_a_per_rad?: number | null;
+            /** Ki Leak Hz */
+            ki_leak_hz?: number | null;
+            /** Kp A Per Rad S */
+            kp_a_per_rad_s?: number | null;
+            /** Speed Filter S */
+            speed_filter_s?: number | null;
+        };
+        /**
+         * SpeedLoopModel
+         * @description The speed loop read now: gains in A/(rad/s), A/rad, A/(rad/s²), filters in Hz, the speed filter in s.
+         */
+        SpeedLoopModel: {
+            /** Control Period S */
+            control_period_s: number;
+            /**
+             * Current Filters Hz
+             * @description the drive's first-order current-command filters, 0 = off
+             */
+            current_filters_hz: number[];
+            /** Device */
+            device: string;
+            /**
+             * Gain Multiplier
+             * @description KJv/256 (1 on a drive without multiplier)
+             */
+            gain_multiplier: number;
+            /** Kc A Per Rad S */
+            kc_a_per_rad_s: number;
+            /** Kd A Per Rad S2 */
+            kd_a_per_rad_s2: number;
+            /** Ki A Per Rad */
+            ki_a_per_rad: number;
+            /** Ki Leak Hz */
+            ki_leak_hz: number;
+            /** Kp A Per Rad S */
+            kp_a_per_rad_s: number;
+            /**
+             * Raw
+             * @description semantic object name → raw value read
+             */
+            raw: {
+                [key: string]: number;
+            };
+            /**
+             * Speed Filter S
+             * @description time constant of the speed-measurement filter
+             */
+            speed_filter_s: number;
+            /**
+             * Torque Constant Nm Per A
+             * @description null: the drive has no torque-constant object
+             */
+            torque_constant_nm_per_a: number | null;
+            /**
+             * Writable
+             * @description the keys a PUT takes on this drive
+             */
+            writable: string[];
+        } & {
+            [key: string]: unknown;
+        };
+        /** SpeedLoopWrite */
+        SpeedLoopWrite: {
+            after: components["schemas"]["SpeedLoopModel"];
+            before: components["schemas"]["SpeedLoopModel"];
+            /**
+             * Written
+             * @description [semantic name, raw value] in the order written
+             */
+            written: unknown[][];
         };
         /** StartRequest */
         StartRequest: {
@@ -7366,6 +7632,102 @@ export interface operations {
             };
         };
     };
+    start_roll_api_buses__bus__nodes__node__scope_roll_post: {
+        parameters: {
+            query?: {
+                /** @description device key (xtrapulspac, cd1k, …) overriding the identified one; by default the node is identified on first use */
+                device?: string | null;
+            };
+            header?: {
+                /** @description id announced by /api/ws/events; required for motion */
+                "X-Servo-Client"?: string | null;
+            };
+            path: {
+                bus: string;
+                node: number;
+            };
+            cookie?: never;
+        };
+        requestBody: {
+            content: {
+                "application/json": components["schemas"]["RollRequest"];
+            };
+        };
+        responses: {
+            /** @description Successful Response */
+            202: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["RollModel"];
+                };
+            };
+            /** @description `not_found`: unknown bus, node, job, object, device, project, axis or motor */
+            404: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `conflict`: the current state refuses it: a changed project, a taken name, the drive; `refused_for_safety`: refused to keep the machine safe (no live client, drive enabled) */
+            409: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `invalid_input`: refused before anything was sent or written */
+            422: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `internal`: a bug: logged with the request id */
+            500: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `communication`: the drive or the link failed part-way (incomplete backup or restore) */
+            502: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `unavailable`: the bus is not connected, or an axis's drive cannot be reached */
+            503: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `timeout`: the drive did not answer in time */
+            504: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+        };
+    };
     get_status_api_buses__bus__nodes__node__scope_status_get: {
         parameters: {
             query?: {
@@ -8414,6 +8776,194 @@ export interface operations {
                 };
                 content: {
                     "application/json": components["schemas"]["RunModel"];
+                };
+            };
+            /** @description `not_found`: unknown bus, node, job, object, device, project, axis or motor */
+            404: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `conflict`: the current state refuses it: a changed project, a taken name, the drive; `refused_for_safety`: refused to keep the machine safe (no live client, drive enabled) */
+            409: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `invalid_input`: refused before anything was sent or written */
+            422: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `internal`: a bug: logged with the request id */
+            500: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `communication`: the drive or the link failed part-way (incomplete backup or restore) */
+            502: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `unavailable`: the bus is not connected, or an axis's drive cannot be reached */
+            503: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `timeout`: the drive did not answer in time */
+            504: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+        };
+    };
+    get_speed_loop_api_buses__bus__nodes__node__speed_loop_get: {
+        parameters: {
+            query?: {
+                /** @description device key (xtrapulspac, cd1k, …) overriding the identified one; by default the node is identified on first use */
+                device?: string | null;
+            };
+            header?: {
+                /** @description id announced by /api/ws/events; required for motion */
+                "X-Servo-Client"?: string | null;
+            };
+            path: {
+                node: number;
+                bus: string;
+            };
+            cookie?: never;
+        };
+        requestBody?: never;
+        responses: {
+            /** @description Successful Response */
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["SpeedLoopModel"];
+                };
+            };
+            /** @description `not_found`: unknown bus, node, job, object, device, project, axis or motor */
+            404: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `conflict`: the current state refuses it: a changed project, a taken name, the drive; `refused_for_safety`: refused to keep the machine safe (no live client, drive enabled) */
+            409: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `invalid_input`: refused before anything was sent or written */
+            422: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `internal`: a bug: logged with the request id */
+            500: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `communication`: the drive or the link failed part-way (incomplete backup or restore) */
+            502: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `unavailable`: the bus is not connected, or an axis's drive cannot be reached */
+            503: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `timeout`: the drive did not answer in time */
+            504: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+        };
+    };
+    put_speed_loop_api_buses__bus__nodes__node__speed_loop_put: {
+        parameters: {
+            query?: {
+                /** @description device key (xtrapulspac, cd1k, …) overriding the identified one; by default the node is identified on first use */
+                device?: string | null;
+            };
+            header?: {
+                /** @description id announced by /api/ws/events; required for motion */
+                "X-Servo-Client"?: string | null;
+            };
+            path: {
+                node: number;
+                bus: string;
+            };
+            cookie?: never;
+        };
+        requestBody: {
+            content: {
+                "application/json": components["schemas"]["SpeedLoopChange"];
+            };
+        };
+        responses: {
+            /** @description Successful Response */
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["SpeedLoopWrite"];
                 };
             };
             /** @description `not_found`: unknown bus, node, job, object, device, project, axis or motor */
@@ -12508,6 +13058,44 @@ export interface operations {
             };
             /** @description `timeout`: the drive did not answer in time */
             504: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+        };
+    };
+    get_settings_api_server_settings_get: {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        requestBody?: never;
+        responses: {
+            /** @description Successful Response */
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ServerSettingsModel"];
+                };
+            };
+            /** @description `invalid_input`: refused before anything was sent or written */
+            422: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `internal`: a bug: logged with the request id */
+            500: {
                 headers: {
                     [name: string]: unknown;
                 };

@@ -103,6 +103,7 @@ def captures(draw) -> Capture:
         columns=columns,
         drive=IDENTITY,
         captured_at="2025-05-01T12:30:05Z",
+        alignment_ns=draw(st.none() | st.integers(0, 10**9)),
     )
 
 
@@ -110,7 +111,8 @@ def captures(draw) -> Capture:
 @given(captures())
 def test_any_capture_reads_back_exactly_from_its_two_files(made):
     text, sidecar = capture_csv(made), capture_sidecar(made, "a.csv")
-    assert parse_capture(text, sidecar, "a.csv", "a.json") == made
+    opened = parse_capture(text, sidecar, "a.csv", "a.json")
+    assert opened == made and opened.alignment_ns == made.alignment_ns  # the sidecar states the alignment too
 
 
 # ---- damage -----------------------------------------------------------------------------------------------------
@@ -139,6 +141,8 @@ def damaged(change) -> tuple[str, str]:
          r"^a\.json:\d+: 'period_ns' is missing or not int"),
         (lambda lines, s: ("".join(lines), s.replace('"version": 1', '"version": 9')), r"^a\.json:3: .*version 1"),
         (lambda lines, s: ("".join(lines), "[]"), r"^a\.json:1: not a capture sidecar"),
+        (lambda lines, s: ("".join(lines), s.replace('"alignment_ns": null', '"alignment_ns": -1')),
+         r"^a\.json:\d+: 'alignment_ns' is not a count of ns"),
         (lambda lines, s: ("".join(lines), s.replace("INTEGER16", "INTEGER99")), r"unknown data type 'INTEGER99'"),
     ],
 )  # fmt: skip

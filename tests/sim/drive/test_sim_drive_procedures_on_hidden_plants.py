@@ -84,8 +84,24 @@ def test_auto_phasing_finds_the_commutation(harness, plant):
         Plant.from_seed(22),
         two_mass(101, 3.0, 200.0),
         two_mass(103, 5.0, 230.0),
+        Plant.from_seed(15),
+        Plant.from_seed(44),
+        two_mass(201, 3.0, 60.0),
+        two_mass(203, 5.0, 80.0),
+        two_mass(205, 4.5, 100.0),
     ],
-    ids=["seed3", "seed11-heavy", "seed22-light", "two-mass-3x", "two-mass-5x"],
+    ids=[
+        "seed3",
+        "seed11-heavy",
+        "seed22-light",
+        "two-mass-3x",
+        "two-mass-5x",
+        "seed15-63Hz-4.9x",
+        "seed44-66Hz",
+        "two-mass-60Hz",
+        "two-mass-80Hz",
+        "two-mass-100Hz",
+    ],
 )
 def test_auto_tuning_identifies_the_plant_and_publishes_it(harness, plant):
     h = datasheet_drive(harness, plant)
@@ -232,3 +248,48 @@ def test_minimum_overshoot_position_step(harness):
     travel = h.drive.physics.theta_motor - start
     assert travel == pytest.approx(TWO_PI / 4, rel=0.01)
     assert (peak - travel) / travel < 0.02
+
+
+GAINS = [(0x60F9, sub) for sub in range(1, 9)] + [(0x60FB, sub) for sub in range(1, 6)] + [(0x30FA, 0)]
+
+
+def vertical(seed: int) -> Plant:
+    """A vertical axis: a constant load torque (gravity) of 30 % of the motor's stall torque, no switches."""
+    plant = Plant.from_seed(seed)
+    free = {name: None for name in ("home_switch", "negative_limit_switch", "positive_limit_switch")}
+    gravity = round(0.3 * plant.torque_constant * plant.stall_current, 4)
+    return replace(plant, **free, negative_hard_stop=None, positive_hard_stop=None, gravity_torque=gravity)
+
+
+def commutated(harness, plant: Plant):
+    h = datasheet_drive(harness, plant)
+    for sub, value in ((1, plant.pole_pairs), (2, plant.phase_order), (3, plant.sensor_offset)):
+        h.write(0x3410, sub, value)
+    return h
+
+
+@pytest.mark.parametrize("seed", [3, 8, 22])
+def test_vertical_axis_is_tuned_enabled_at_standstill(harness, seed):
+    """The manual's vertical-load procedure (§1.8.16): auto-tune the motor uncoupled, couple the load and hold it
+    with those gains, then auto-tune enabled at standstill; the constant load torque is identified (0x3428,4 is the
+    load's torque in the + direction: gravity pulls −) and the tuned axis holds its position."""
+    plant = vertical(seed)
+    motor = commutated(harness, replace(plant, load_inertia=0.0, coupling_stiffness=0.0, gravity_torque=0.0))
+    motor.write(0x6060, 0, 1)
+    assert run_procedure(motor, (0x3426, 0), 30.0) == 5
+    h = commutated(harness, plant)
+    for index, sub in GAINS:
+        h.write(index, sub, motor.read(index, sub))
+    h.enable(1)
+    h.run(0.3)
+    assert run_procedure(h, (0x3426, 0), 30.0) == 5
+    inertia, viscous, coulomb, load = (h.read(0x3428, s) for s in range(1, 5))
+    assert inertia == pytest.approx(plant.total_inertia, rel=0.10)
+    assert viscous == pytest.approx(plant.viscous_friction, rel=0.25)
+    assert coulomb == pytest.approx(plant.coulomb_friction, rel=0.10)
+    assert load == pytest.approx(-plant.gravity_torque, rel=0.10)
+    h.run(0.5)
+    held = h.drive.physics.theta_motor
+    h.run(0.5)
+    assert h.status & 0x6F == 0x27
+    assert abs(h.drive.physics.theta_motor - held) < 0.01  # rad: the load does not sink

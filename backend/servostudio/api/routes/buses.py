@@ -103,6 +103,8 @@ def scan_bus(connection: OpenBus, response: Response) -> list[dict]:
     dependencies=[Requires(Level.EXPERT)],
 )
 def nmt(request: NmtRequest, connection: OpenBus) -> None:
+    """Judged by the motion guard for every node it reaches and logged as writes are: a start of an enabled axis
+    needs its armed controller (409 otherwise); a reset of an enabled axis is a stop (docs/motion-safety.md)."""
     connection.nmt(request.command, request.node)
 
 

@@ -8,12 +8,17 @@ Operator's way out; ``/api/jobs/{id}/cancel`` does the same for Maintenance and 
 
 from __future__ import annotations
 
+import asyncio
+import contextlib
+import json
+from collections.abc import Callable
 from urllib.parse import quote
 
-from fastapi import APIRouter, Response, status
+from fastapi import APIRouter, Response, WebSocket, WebSocketDisconnect, status
 
-from servostudio.api.deps import Jobs, NodeDrive, OpenBus, Projects, ScopeCaptures
-from servostudio.api.errors import error_responses
+from servostudio.api.auth import identify
+from servostudio.api.deps import Access, Jobs, NodeDrive, OpenBus, Projects, ScopeCaptures
+from servostudio.api.errors import error_body, error_responses
 from servostudio.api.routes.comm_models import JobModel
 from servostudio.api.routes.drives import DRIVE_ERRORS
 from servostudio.api.routes.scope_models import (
@@ -21,6 +26,8 @@ from servostudio.api.routes.scope_models import (
     CaptureRequest,
     PlanModel,
     RecorderStatus,
+    RollModel,
+    RollRequest,
     SavedCaptureModel,
     SaveRequest,
     ScopeInfo,
@@ -28,15 +35,20 @@ from servostudio.api.routes.scope_models import (
     plan_model,
     saved_model,
 )
-from servostudio.api.security import Requires
-from servostudio.errors import ErrorKind
+from servostudio.api.security import Requires, require_message
+from servostudio.errors import ErrorKind, ServoStudioError
 from servostudio.services.scope import Capture, CaptureStore, capture_csv, capture_html, check
+from servostudio.services.scope.roll import RollFeed
 from servostudio.services.scope.service import UnknownCapture
-from servostudio.services.users import Level
+from servostudio.services.users import AccessControl, Level
 
 LIVE = "/buses/{bus}/nodes/{node}/scope"
 SAVED = "/projects/{project}/axes/{axis}/captures"
 SAVED_ERRORS = (ErrorKind.NOT_FOUND, ErrorKind.CONFLICT)
+#: the roll socket's client messages and the level each needs (checked per message, with the caller as it is then)
+ROLL_MESSAGES: dict[str, Level] = {"stop": Level.OPERATOR}
+#: how often the roll socket sends what the roll delivered (the display latency's share of the server)
+ROLL_SEND_SECONDS = 0.01
 router = APIRouter(tags=["scope"])
 
 
@@ -78,6 +90,70 @@ def start_capture(
     request: CaptureRequest, connection: OpenBus, drive: NodeDrive, jobs: Jobs, scope: ScopeCaptures
 ) -> dict:
     return scope.start(jobs, connection, drive, request.definition()).as_dict()
+
+
+@router.post(
+    f"{LIVE}/roll",
+    response_model=RollModel,
+    status_code=status.HTTP_202_ACCEPTED,
+    summary="Live roll mode: stream up to 4 channels per axis through TPDOs at the server's SYNC (the bus budget is "
+    "checked first: 422 when over-subscribed); the samples on the WebSocket the answer names",
+    responses=error_responses(*DRIVE_ERRORS),
+    dependencies=[Requires(Level.OPERATOR)],
+)
+def start_roll(request: RollRequest, connection: OpenBus, drive: NodeDrive, jobs: Jobs, scope: ScopeCaptures) -> dict:
+    job, plan = scope.start_roll(jobs, connection, drive, request.definition(), request.seconds, request.record)
+    return {"job": job.as_dict(), "plan": plan_model(plan), "socket": f"/api/ws/scope/{job.id}"}
+
+
+@router.websocket("/ws/scope/{roll}", dependencies=[Requires(Level.OPERATOR)])
+async def roll_socket(socket: WebSocket, roll: str, scope: ScopeCaptures, jobs: Jobs, control: Access) -> None:
+    """A roll's events as JSON: ``samples`` (``seq`` of the first, ``count``, ``values`` per channel in physical
+    units, ``synced_at`` of the first and last sample's SYNC, Unix s), ``gap`` (``from``, ``to``, ``reason``) and
+    ``end`` (the summary). The client may send ``{"type": "stop"}`` (Operator) to end the roll."""
+    await socket.accept()
+    try:
+        feed = scope.feed(roll)
+    except ServoStudioError as error:
+        await socket.close(code=4404, reason=str(error))
+        return
+    receiver = asyncio.create_task(_roll_messages(socket, control, lambda: jobs.cancel(roll)))
+    try:
+        await _send_roll(socket, feed, receiver)
+    except (WebSocketDisconnect, RuntimeError):  # RuntimeError: sending after the client closed
+        pass
+    finally:
+        receiver.cancel()
+
+
+async def _send_roll(socket: WebSocket, feed: RollFeed, receiver: asyncio.Task[None]) -> None:
+    cursor = 0
+    while not receiver.done():
+        events, cursor = feed.since(cursor)
+        for event in events:
+            await socket.send_json(event)
+        if any(event["type"] == "end" for event in events):
+            await socket.close()
+            return
+        await asyncio.sleep(ROLL_SEND_SECONDS)
+
+
+async def _roll_messages(socket: WebSocket, control: AccessControl, stop: Callable[[], object]) -> None:
+    """Client messages until it disconnects: a stop of a caller at its level ends the roll; a refused one is
+    answered with the error (as the terminal does); anything else is ignored."""
+    with contextlib.suppress(WebSocketDisconnect):
+        while True:
+            text = await socket.receive_text()
+            with contextlib.suppress(ValueError):
+                message = json.loads(text)
+                kind = str(message.get("type")) if isinstance(message, dict) else ""
+                try:
+                    require_message(identify(socket, control), ROLL_MESSAGES, kind, "scope roll")
+                except ServoStudioError as error:
+                    await socket.send_json({"type": "error", **error_body(error)})
+                    continue
+                if kind == "stop":
+                    stop()
 
 
 @router.get(

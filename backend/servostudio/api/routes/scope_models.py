@@ -8,6 +8,7 @@ from typing import Annotated, Literal
 
 from pydantic import BaseModel, ConfigDict, Field
 
+from servostudio.api.routes.comm_models import JobModel
 from servostudio.services.scope import Capture, CaptureDefinition, ChannelInfo, SavedCapture, Trigger
 from servostudio.services.scope.plan import CapturePlan
 from servostudio.services.scope.stream_plan import StreamPlan
@@ -233,3 +234,28 @@ def plan_model(plan: CapturePlan | StreamPlan) -> PlanModel:
         record_size=plan.record_size,
         bytes=plan.total_bytes,
     )
+
+
+class RollRequest(BaseModel):
+    """Live roll mode: up to 4 channels per axis (``OBJ@NODE`` for another axis of the bus) through synchronous
+    TPDOs at the server's SYNC; the bus budget is checked before anything is armed (422 when over-subscribed)."""
+
+    model_config = ConfigDict(
+        extra="forbid",
+        json_schema_extra={"examples": [{"channels": ["0x6064,0", "0x606C,0"], "period_us": 1000, "record": True}]},
+    )
+    channels: list[ObjectName] = Field(min_length=1, max_length=16, description="objects by address or name")
+    period_us: float = Field(1000.0, gt=0, le=1e9, description="the SYNC period: 1000 µs (1 kHz) at the fastest")
+    seconds: float | None = Field(None, gt=0, le=86400, description="roll this long; none: until stopped")
+    record: bool = Field(False, description="keep every sample (up to the first gap) as a capture at the end")
+
+    def definition(self) -> CaptureDefinition:
+        return CaptureDefinition(tuple(self.channels), period_us=self.period_us, source="tpdo")
+
+
+class RollModel(BaseModel):
+    """A roll started: its job (``scope-roll``), the plan with the bus budget, and the WebSocket of its samples."""
+
+    job: JobModel
+    plan: PlanModel
+    socket: str = Field(description="GET as WebSocket: the roll's samples, gaps and end (docs/scope.md §8)")

@@ -9,6 +9,7 @@ from typing import TYPE_CHECKING
 
 from servostudio.drive.faults import CodedBits, FaultInfo, cia402_error_text
 from servostudio.drive.profiles.procedures import NO_PROCEDURES, ProcedureSet
+from servostudio.drive.profiles.speed_loop import SpeedLoopDescription
 from servostudio.errors import NotFound
 from servostudio.od.model import SaveType
 
@@ -162,6 +163,8 @@ class DeviceProfile:
     recorder: RecorderDescription | None = None
     #: the signature-started procedures (phasing, current loop, auto-tuning) as the procedure service runs them
     procedures: ProcedureSet = NO_PROCEDURES
+    #: the speed loop's gain and filter objects and their scalings; None: the drive has no gain objects
+    speed_loop: SpeedLoopDescription | None = None
 
     def address(self, name: str) -> tuple[int, int]:
         try:

@@ -14,6 +14,7 @@ from servostudio.drive.profiles.base import CIA301_OBJECTS, CIA402_OBJECTS, Addr
 from servostudio.drive.profiles.cd1k_procedures import CD1K_PROCEDURES
 from servostudio.drive.profiles.homing import HOMING_METHODS
 from servostudio.drive.profiles.procedures import IDENTIFIED_PLANT_OBJECTS
+from servostudio.drive.profiles.speed_loop import CD1K_SPEED_LOOP
 
 _STOP_MASKS = "Its stop (disable, stop 1 or stop 3) follows the masks 3330h / 3331h."
 
@@ -187,5 +188,6 @@ CD1K = DeviceProfile(
         "auto_tuning": ("max_current_share", "rated_current_share"),
     },
     procedures=CD1K_PROCEDURES,
+    speed_loop=CD1K_SPEED_LOOP,
     homing_methods=HOMING_METHODS,
 )

@@ -13,6 +13,7 @@ from servostudio.drive.profiles.base import (
 from servostudio.drive.profiles.homing import HOMING_METHODS
 from servostudio.drive.profiles.procedures import IDENTIFIED_PLANT_OBJECTS
 from servostudio.drive.profiles.recorder import XTRAPULSPAC_RECORDER
+from servostudio.drive.profiles.speed_loop import XTRAPULSPAC_SPEED_LOOP
 from servostudio.drive.profiles.xtrapulspac_faults import ERRORS, WARNINGS
 from servostudio.drive.profiles.xtrapulspac_procedures import XTRAPULSPAC_PROCEDURES
 from servostudio.od.model import SaveType
@@ -154,5 +155,6 @@ XTRAPULSPAC = DeviceProfile(
     },
     recorder=XTRAPULSPAC_RECORDER,
     procedures=XTRAPULSPAC_PROCEDURES,
+    speed_loop=XTRAPULSPAC_SPEED_LOOP,
     homing_methods=HOMING_METHODS,
 )

@@ -112,6 +112,7 @@ class BusConnection:
     gate: WriteGate = OPEN_GATE  # every write of the bus's drives passes it: the manager's motion guard
     monitor: BusMonitor | None = None
     share: BusShare | None = None  # its socketcand endpoint for the user's own scripts, when shared
+    motion: MotionGuard | None = None  # judges and logs its NMT commands (the manager's guard)
     _identifying: dict[int, threading.Lock] = field(default_factory=dict, repr=False)
     _identifying_guard: threading.Lock = field(default_factory=threading.Lock, repr=False)
 
@@ -145,10 +146,27 @@ class BusConnection:
         return info.device if info else None
 
     def nmt(self, command: str, node: int = 0) -> NmtCommand:
-        """Send an NMT command named as the CLI and REST name it (``start``, ``reset-node``, …); node 0: all."""
+        """Send an NMT command named as the CLI and REST name it (``start``, ``reset-node``, …); node 0: all.
+
+        A start can make an axis move and a reset stop it, so the motion guard judges the command for every node
+        it addresses (node 0: every node a scan found) and logs it, as it does writes (``docs/motion-safety.md``)."""
         parsed = NmtCommand.parse(command)
-        send_nmt(self.link, parsed, node)
+        heard = self.motion.admit_nmt(self.id, parsed, self._nmt_targets(node)) if self.motion else None
+        try:
+            send_nmt(self.link, parsed, node)
+        except ServoStudioError as error:
+            if heard is not None:
+                heard(error)
+            raise
+        if heard is not None:
+            heard(None)
         return parsed
+
+    def _nmt_targets(self, node: int) -> list[tuple[int, Drive, str | None]]:
+        """The nodes an NMT command to ``node`` reaches, with their drives and NMT states (none when out of range:
+        ``send_nmt`` refuses it)."""
+        nodes = [node] if 1 <= node <= 127 else sorted(self.nodes) if node == 0 else []
+        return [(each, self.drive(each), self.nmt_state(each)) for each in nodes]
 
     def report_statusword(self, node: int, statusword: int) -> None:
         """Publish a drive_state event when a status word read elsewhere shows a state change."""
@@ -235,6 +253,7 @@ class ConnectionManager:
             self.events,
             simulation=simulation,
             gate=self.motion.gate(bus_id),
+            motion=self.motion,
         )
         connection.monitor = BusMonitor(link, self.events.publish, connection.profile_of)
         StatuswordWatch(connection, lambda: self.events.wants("drive_state"))

@@ -15,6 +15,7 @@ from dataclasses import dataclass, replace
 
 from servostudio.drive.access import PlannedWrite
 from servostudio.drive.cia402 import State, transition
+from servostudio.drive.nmt import NmtCommand
 from servostudio.drive.profiles import DeviceProfile, signature_value
 
 
@@ -133,3 +134,29 @@ def _motion_object(state: State | None, write: PlannedWrite) -> Verdict:
     if state in (State.OPERATION_ENABLED, None):
         return Verdict(Motion.MOVES, f"{label} = {write.raw!r} changes what the enabled axis does")
     return Verdict(Motion.PREPARES, f"{label} = {write.raw!r} sets up the axis's next motion")
+
+
+#: NMT commands after which the drive acts on other values: OPERATIONAL makes its RPDOs act (the control word and
+#: set-points another device sends); a reset reloads its stored parameters (the mode, targets: XtrapulsPac 0x205D)
+#: or its communication objects (PDO mappings) — into a running axis if it is enabled
+_ACTS_ON_OTHER_VALUES = {
+    NmtCommand.START: "its RPDOs (the control word and set-points another device sends) then act on",
+    NmtCommand.RESET_NODE: "the drive restarts or reloads its stored parameters (mode, targets) into",
+    NmtCommand.RESET_COMMUNICATION: "its PDO mappings return to their power-on values in",
+}
+
+
+def judge_nmt(command: NmtCommand, node: int, state: State | None, nmt_state: str | None) -> Verdict:
+    """What an NMT command makes the axis of ``node`` do (``state``: its CiA 402 state, None when unknown), judged
+    as a motion object's write is: start and the resets make the drive act on other values — on an enabled axis
+    that changes what it does (moving; the worst case of the devices), on a disabled one it sets up its next motion
+    (preparing).  Stop and pre-operational end PDO control and start nothing (the drive's abort-connection option,
+    0x6007, decides what an enabled axis does: stopping an axis never needs its controller)."""
+    name = command.name.lower().replace("_", "-")
+    acts = _ACTS_ON_OTHER_VALUES.get(command)
+    if acts is None or (command is NmtCommand.START and nmt_state == "OPERATIONAL"):
+        return Verdict(Motion.NONE, f"NMT {name} of node {node}")
+    if state in (State.OPERATION_ENABLED, None):
+        shown = "the enabled axis" if state is not None else "an axis whose state is unknown"
+        return Verdict(Motion.MOVES, f"NMT {name} of node {node}: {acts} {shown}")
+    return Verdict(Motion.PREPARES, f"NMT {name} of node {node}: {acts} the axis's next motion")

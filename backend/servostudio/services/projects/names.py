@@ -7,6 +7,8 @@ separators, no reserved device names, no trailing dot or space, and uniqueness i
 from __future__ import annotations
 
 import re
+from datetime import datetime
+from pathlib import Path
 
 from servostudio.services.projects.errors import InvalidName
 
@@ -39,3 +41,22 @@ def is_valid_name(name: str) -> bool:
     except InvalidName:
         return False
     return True
+
+
+def timestamp_name(directory: Path, time: str, fallback: str) -> str:
+    """A record's file stem from its ISO time (``2026-12-02 05-01-02``), numbered when that name is taken.
+
+    Captures and frequency responses are saved under the time they were measured; ``fallback`` names a record whose
+    time does not parse.
+    """
+    try:
+        stamp = datetime.fromisoformat(time.replace("Z", "+00:00")).strftime("%Y-%m-%d %H-%M-%S")
+    except ValueError:
+        stamp = fallback
+    candidates = [stamp, *(f"{stamp}-{number}" for number in range(2, 1000))]
+    return next(candidate for candidate in candidates if not name_taken(directory, candidate))
+
+
+def name_taken(directory: Path, name: str) -> bool:
+    """Whether a record (its ``.json`` sidecar) of that name, in any case, is already in ``directory``."""
+    return directory.is_dir() and any(same_name(path.stem, name) for path in directory.glob("*.json"))

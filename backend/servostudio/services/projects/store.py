@@ -416,7 +416,7 @@ def setting_files(directory: Path) -> list[Path]:
 
 
 #: second path components (``<axis>/<dir>/…``) whose files are records, not settings
-RECORD_DIRS = ([layout.CAPTURES_DIR], [layout.PROCEDURES_DIR])
+RECORD_DIRS = ([layout.CAPTURES_DIR], [layout.PROCEDURES_DIR], [layout.FREQUENCY_DIR])
 
 
 def _project_files(directory: Path) -> Iterator[Path]:

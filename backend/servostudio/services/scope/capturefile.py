@@ -84,6 +84,7 @@ def capture_sidecar(capture: Capture, data_name: str) -> str:
         "samples": capture.samples,
         "trigger_index": capture.trigger_index,
         "channels": [asdict(channel) for channel in capture.channels],
+        "alignment_ns": capture.alignment_ns,
     }
     return json.dumps(sidecar, indent=2, ensure_ascii=False) + "\n"
 
@@ -119,6 +120,7 @@ def parse_capture(csv_text: str, sidecar_text: str, csv_label: str, sidecar_labe
         drive=header.drive,
         captured_at=header.captured_at,
         source=header.source,
+        alignment_ns=header.alignment_ns,
     )
 
 
@@ -161,6 +163,7 @@ class Sidecar:
     drive: DriveIdentity
     captured_at: str
     source: str
+    alignment_ns: int | None
 
     @classmethod
     def of(cls, fields: Mapping[str, Any], text: str, label: str) -> Sidecar:
@@ -184,6 +187,7 @@ class Sidecar:
             drive=field("drive", dict, lambda values: DriveIdentity(**values)),
             captured_at=field("captured_at", str),
             source=field("source", str),
+            alignment_ns=_alignment(fields, text, label),
         )
         header._check(text, label)
         return header
@@ -198,6 +202,16 @@ class Sidecar:
                 ) from None
         if not self.channels or self.period_ns <= 0 or not 0 <= self.trigger_index < max(self.samples, 1):
             raise CaptureFileError(f"{label}:1: channels, period or trigger sample out of range")
+
+
+def _alignment(fields: Mapping[str, Any], text: str, label: str) -> int | None:
+    """The samples' largest distance from their instants (ns; absent or null: not stated, as in older files)."""
+    value = fields.get("alignment_ns")
+    if value is None:
+        return None
+    if not isinstance(value, int) or isinstance(value, bool) or value < 0:
+        raise CaptureFileError(f"{label}:{_line_of(text, 'alignment_ns')}: 'alignment_ns' is not a count of ns")
+    return value
 
 
 def _read_rows(text: str, label: str, header: Sidecar) -> tuple[tuple[Number, ...], ...]:

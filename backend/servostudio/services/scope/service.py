@@ -32,11 +32,14 @@ from servostudio.services.scope.definition import CaptureDefinition, split_chann
 from servostudio.services.scope.plan import CapturePlan, CaptureRefused, plan_capture, recorder_of
 from servostudio.services.scope.presets import presets_for
 from servostudio.services.scope.recorder import POLL_SECONDS, RecorderSession, Report
+from servostudio.services.scope.roll import RollFeed, RollStream, roll_plan
 from servostudio.services.scope.stream import PollStream, StreamResult, TpdoStream
 from servostudio.services.scope.stream_plan import Axes, Bus, StreamPlan, plan_stream
 
 #: captures the server keeps for its clients (a 4 × 2048 capture is about 0.3 MB in memory)
 KEEP_CAPTURES = 16
+#: roll feeds the server keeps (a finished roll's last events stay readable for a while)
+KEEP_FEEDS = 8
 #: how long a stop waits for the node's capture job to end (a status read or an upload part: milliseconds)
 STOP_WAIT = 5.0
 Node = tuple[str, int]
@@ -127,13 +130,18 @@ def capture(drive: Drive, identity: DriveIdentity, definition: CaptureDefinition
 def stream_once(drive: Drive, plan: StreamPlan, identity: DriveIdentity, report: Report,
                 cancellation: Cancellation, axes: Axes | None) -> Capture:  # fmt: skip
     """A capture through TPDOs or by polling (the plan says which)."""
-    reach = axes or _alone(drive)
-    nodes = {node: drive if node == drive.node else reach(node) for node in plan.nodes}
+    reach = _reach(drive, plan, axes)
     if plan.source == "tpdo":
-        result = TpdoStream(plan, nodes.__getitem__, drive.engine.link).run(report, cancellation)
+        result = TpdoStream(plan, reach, drive.engine.link).run(report, cancellation)
     else:
-        result = PollStream(plan, nodes.__getitem__).run(report, cancellation)
+        result = PollStream(plan, reach).run(report, cancellation)
     return streamed_capture(plan, result, identity)
+
+
+def _reach(drive: Drive, plan: StreamPlan, axes: Axes | None) -> Axes:
+    """Each node of the plan's drive (the capture's own node is ``drive``)."""
+    reach = axes or _alone(drive)
+    return {node: drive if node == drive.node else reach(node) for node in plan.nodes}.__getitem__
 
 
 def streamed_capture(plan: StreamPlan, result: StreamResult, identity: DriveIdentity) -> Capture:
@@ -165,6 +173,7 @@ class ScopeService:
         self.keep = keep
         self._captures: OrderedDict[str, Capture] = OrderedDict()
         self._running: dict[Node, Job] = {}
+        self._feeds: OrderedDict[str, RollFeed] = OrderedDict()
         self._numbers = itertools.count(1)
         self._lock = threading.Lock()
 
@@ -209,20 +218,65 @@ class ScopeService:
         job holds every node whose channels it captures."""
         plan = check(drive, definition, connection.drive, connection.spec.bitrate)
         node = (connection.id, drive.node)
-        held = [(connection.id, other) for other in (plan.nodes if isinstance(plan, StreamPlan) else (drive.node,))]
         identity = identity_of(connection, drive)
+
+        def work(progress: Callable[[dict[str, object]], None], cancellation: Cancellation) -> object:
+            return self._run(drive, plan, identity, _on_node(progress, node), cancellation, connection.drive)
+
+        nodes = plan.nodes if isinstance(plan, StreamPlan) else (drive.node,)
+        return self._claim(connection.id, nodes, lambda: jobs.start("scope", work))
+
+    def _claim(self, bus: str, nodes: tuple[int, ...], start: Callable[[], Job]) -> Job:
+        """Start a job that holds ``nodes`` (none of which may run a capture or a roll already)."""
+        held = [(bus, other) for other in nodes]
         with self._lock:
             for other in held:
                 running = self._running.get(other)
                 if running is not None and running.state == "running":
                     raise CaptureRunning(f"node {other[1]}: capture {running.id} is running; stop it first")
-
-            def work(progress: Callable[[dict[str, object]], None], cancellation: Cancellation) -> object:
-                return self._run(drive, plan, identity, _on_node(progress, node), cancellation, connection.drive)
-
-            job = jobs.start("scope", work)
+            job = start()
             self._running.update(dict.fromkeys(held, job))
         return job
+
+    def start_roll(self, jobs: JobRegistry, connection: BusConnection, drive: Drive, definition: CaptureDefinition,
+                   seconds: float | None, record: bool) -> tuple[Job, StreamPlan]:  # fmt: skip
+        """Check the roll (its bus budget above all: refused before anything is armed), then roll in a job whose
+        samples the feed of the job's id serves (``feed``); recorded, the samples become a capture at the end."""
+        plan = roll_plan(drive, connection.drive, definition, connection.spec.bitrate, seconds)
+        identity, feed = identity_of(connection, drive), RollFeed()
+        node = (connection.id, drive.node)
+
+        def work(progress: Callable[[dict[str, object]], None], cancellation: Cancellation) -> object:
+            stream = RollStream(plan, _reach(drive, plan, connection.drive), drive.engine.link, feed.put, seconds,
+                                record)  # fmt: skip
+            return self._roll(stream, identity, _on_node(progress, node), cancellation, feed)
+
+        job = self._claim(connection.id, plan.nodes, lambda: jobs.start("scope-roll", work))
+        with self._lock:
+            self._feeds[job.id] = feed
+            while len(self._feeds) > KEEP_FEEDS:
+                self._feeds.popitem(last=False)
+        return job, plan
+
+    def _roll(self, stream: RollStream, identity: DriveIdentity, report: Report, cancellation: Cancellation,
+              feed: RollFeed) -> dict[str, object]:  # fmt: skip
+        try:
+            result = stream.run(report, cancellation)
+        except Exception as error:
+            feed.put({"type": "end", "error": str(error)})
+            raise
+        summary: dict[str, object] = {**stream.summary(), "bus": identity.bus, "node": identity.node}
+        if result.columns:
+            summary["capture"] = self.remember(streamed_capture(stream.plan, result, identity))
+        feed.put({"type": "end", **summary})
+        return summary
+
+    def feed(self, roll: str) -> RollFeed:
+        """The samples of a roll job (the latest few rolls are kept)."""
+        try:
+            return self._feeds[roll]
+        except KeyError:
+            raise UnknownCapture(f"no roll {roll!r} (the server keeps the latest {KEEP_FEEDS})") from None
 
     def _run(self, drive: Drive, plan: CapturePlan | StreamPlan, identity: DriveIdentity, report: Report,
              cancellation: Cancellation, axes: Axes) -> dict[str, object]:  # fmt: skip

@@ -9,13 +9,12 @@ not part of the project's revision (``projects.store.revision_of``).
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
-from datetime import datetime
 from pathlib import Path
 
 from servostudio.errors import Conflict, NotFound
 from servostudio.services.projects import layout
 from servostudio.services.projects.fsutil import atomic_write
-from servostudio.services.projects.names import check_name, same_name
+from servostudio.services.projects.names import check_name, name_taken, timestamp_name
 from servostudio.services.projects.store import ProjectStore
 from servostudio.services.scope.capture import Capture
 from servostudio.services.scope.capturefile import (
@@ -57,8 +56,8 @@ class CaptureStore:
         """Save ``capture`` under ``name`` (default: its time of capture); a taken name is refused."""
         with self.projects.edit(project) as edit:
             directory = edit.axis_directory(axis) / layout.CAPTURES_DIR
-            chosen = check_name(name, "capture") if name else _free_name(directory, capture.captured_at)
-            if name and _taken(directory, chosen):
+            chosen = check_name(name, "capture") if name else timestamp_name(directory, capture.captured_at, "capture")
+            if name and name_taken(directory, chosen):
                 raise CaptureExists(f"axis '{axis}' has a capture named '{chosen}' already; choose another name")
             directory.mkdir(parents=True, exist_ok=True)
             atomic_write(directory / f"{chosen}.csv", capture_csv(capture))
@@ -108,22 +107,6 @@ def _summary(path: Path, axis: str) -> SavedCapture:
         trigger=header.trigger,
         source=header.source,
     )
-
-
-def _free_name(directory: Path, captured_at: str) -> str:
-    """``2025-05-01 12-30-05`` from the time of capture, numbered when that name is taken."""
-    try:
-        stamp = datetime.fromisoformat(captured_at.replace("Z", "+00:00")).strftime("%Y-%m-%d %H-%M-%S")
-    except ValueError:
-        stamp = "capture"
-    candidates = [stamp, *(f"{stamp}-{number}" for number in range(2, 1000))]
-    return next(candidate for candidate in candidates if not _taken(directory, candidate))
-
-
-def _taken(directory: Path, name: str) -> bool:
-    if not directory.is_dir():
-        return False
-    return any(same_name(path.stem, name) for path in directory.glob("*.json"))
 
 
 def _label(axis: str, path: Path) -> str:

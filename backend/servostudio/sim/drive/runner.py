@@ -90,7 +90,8 @@ class ProcedureRunner:
         drive.loops.reset_integrators()
 
     def _create(self, name: str) -> Any:
-        """A procedure needs the drive disabled without fault (auto-tuning may also run enabled at standstill)."""
+        """A procedure needs the drive disabled without fault; auto-tuning may also run enabled at standstill (a
+        vertical load, manual §1.8.16: "if the axis is moving, the procedure has not been accepted")."""
         drive = self.drive
         state = drive.device_control.state
         disabled = state in _DISABLED_STATES and not drive.device_control.power_on
@@ -99,9 +100,11 @@ class ProcedureRunner:
             return AutoPhasing(drive.dt, current)
         if name == "mcal" and disabled:
             return MotorPhasing(drive.dt, current, drive.loops.pole_pairs, drive.loops.phase_sign)
-        at_standstill = state is State.OPERATION_ENABLED and abs(drive.loops.speed) < 1.0
+        enabled = state is State.OPERATION_ENABLED
+        at_standstill = enabled and abs(drive.loops.speed) < 1.0
         if name == "atun" and (disabled or at_standstill) and not drive.brake_engaged():
-            return AutoTuning(drive.dt, current, self._torque_constant())
+            # enabled (a vertical load): the current that holds the axis now keeps holding it while tuning
+            return AutoTuning(drive.dt, current, self._torque_constant(), drive.loops.i_q if enabled else 0.0)
         return None
 
     def _torque_constant(self) -> float:

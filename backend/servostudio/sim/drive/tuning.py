@@ -37,10 +37,17 @@ WANTED_SPEED = 10.0
 TRAVEL = 3.8
 """rad: the excursion of one plateau pass (the axis swings ±TRAVEL about its start)."""
 HOLD = 0.06
+"""s: plateau length on a rigid axis (or one resonating far above the soft loop)."""
 RAMP_MIN = 0.04
 AVERAGE = 0.01
 """s: half-width of the position window that gives a speed at a row's end."""
 LOOP_HZ = 15.0
+SOFT_SHARE = 1.0 / 8.0
+"""With a coupling resonance f_r seen in the coast, the soft loop stays below f_r·SOFT_SHARE, each plateau lasts
+HOLD_PERIODS resonance periods and the end speeds average one period: a low resonance (60–100 Hz, its
+anti-resonance near the soft loop) otherwise leaves motor and load swinging against each other at the plateau ends,
+and the motor's speed alone then misstates the momentum (measured on seed 15: viscous friction 3.5 × the truth)."""
+HOLD_PERIODS = 6.0
 ACCELERATION_SHARE = 0.3
 """Peak acceleration torque of the plateau ramps as a share of Kt·I (room for friction and the loop)."""
 REST = 0.03
@@ -66,10 +73,15 @@ class Identified:
 class AutoTuning:
     """Drive it with `step(position, speed, current)` each period; read `current_demand` for the q current."""
 
-    def __init__(self, dt: float, current: float, torque_constant: float) -> None:
+    def __init__(self, dt: float, current: float, torque_constant: float, bias: float = 0.0) -> None:
         self.dt = dt
         self.current = current
         self.torque_constant = torque_constant
+        self.bias = bias
+        """q current that held the axis at standstill when tuning started enabled (a vertical load): every stage
+        adds it, so the load does not fall while the axis coasts."""
+        self.swing = current - abs(bias)
+        """Current available above the holding current: the pulses' height and the plateaus' acceleration budget."""
         self.current_demand = 0.0
         self.result: Identified | None = None
         self.failed_reason = ""
@@ -84,6 +96,9 @@ class AutoTuning:
             return True
         if self.current <= 0.0:
             self.failed_reason = "no current available (rated/max current 0x6075/0x6073 is 0)"
+            return True
+        if self.swing <= 0.1 * self.current:
+            self.failed_reason = "the load torque takes all the current (holding current close to the limit)"
             return True
         demand, following = self._stage.step(position, speed, current)
         self.current_demand = max(-self.current, min(self.current, demand))
@@ -122,18 +137,19 @@ class _PulseStage(_Stage):
         self.time += self.tuning.dt
         pulse, t = self.pulse, self.time
         cycle = pulse + COAST
+        bias, swing = self.tuning.bias, self.tuning.swing
         if t < 2 * cycle + REST:
             if t < pulse:
-                return self.tuning.current, None
+                return bias + swing, None
             if cycle <= t < cycle + pulse:
-                return -self.tuning.current, None
-            return 0.0, None
+                return bias - swing, None
+            return bias, None
         estimate = self._estimate()
         if estimate is not None and estimate[0] > 0.0:
-            return 0.0, _PlateauStage(self.tuning, *estimate)
+            return bias, _PlateauStage(self.tuning, *estimate)
         if pulse * 2 > MAX_PULSE:
             return self._fail("the axis did not move as a free inertia (blocked, brake engaged?)")
-        return 0.0, _PulseStage(self.tuning, pulse * 2)
+        return bias, _PulseStage(self.tuning, pulse * 2)
 
     def _estimate(self) -> tuple[float, float] | None:
         """(J0, friction torque) from the first pulse (from rest), or None if the coast was too short or slow.
@@ -148,7 +164,7 @@ class _PulseStage(_Stage):
         velocity, acceleration, residuals = _quadratic_fit(moving, dt)
         if velocity < WANTED_SPEED:
             return None
-        torque = self.tuning.torque_constant * self.tuning.current
+        torque = self.tuning.torque_constant * self.tuning.swing
         inertia = torque * self.pulse / (velocity - acceleration * self.pulse)
         self.tuning.resonance_hz = _ringing_hz(residuals[SETTLE:], dt)
         return inertia, -inertia * acceleration
@@ -179,6 +195,7 @@ def _ringing_hz(residuals: list[float], dt: float) -> float:
     count = len(residuals)
     if count < 24:
         return 0.0
+    original = residuals
     cubic = _least_squares([([1.0, n, n * n, n * n * n], r) for n, r in enumerate(residuals)], 4) or [0.0] * 4
     residuals = [r - sum(c * n**k for k, c in enumerate(cubic)) for n, r in enumerate(residuals)]
     window = [0.5 - 0.5 * math.cos(TWO_PI * n / (count - 1)) for n in range(count)]
@@ -195,7 +212,27 @@ def _ringing_hz(residuals: list[float], dt: float) -> float:
     amplitude, peak = max(spectrum)
     floor = sorted(a for a, _ in spectrum)[len(spectrum) // 2]
     inside = spectrum[0][1] < peak < spectrum[-1][1]  # a peak at the scan's edge is the fit's leftover trend
-    return peak if inside and amplitude >= RINGING_MIN_RAD and amplitude >= 4.0 * floor else 0.0
+    found = inside and amplitude >= RINGING_MIN_RAD and amplitude >= 4.0 * floor
+    return _refined_hz(original, peak, dt) if found else 0.0
+
+
+def _refined_hz(residuals: list[float], peak: float, dt: float) -> float:
+    """The ringing's frequency to 1 Hz: the spectrum of a coast that holds only one or two periods of a low
+    resonance (and less its cubic trend) peaks well above it (82 Hz for 63 Hz); a least-squares sine plus quadratic
+    trend, scanned from half to 1.2 × that peak, is unbiased on so short a record. A best fit at the scan's edge
+    means the residual is no ringing (a rigid axis coasting under gravity): 0."""
+
+    def misfit(frequency: float) -> float:
+        turn = TWO_PI * frequency * dt
+        rows = [([1.0, n, n * n, math.cos(turn * n), math.sin(turn * n)], r) for n, r in enumerate(residuals)]
+        solution = _least_squares(rows, 5)
+        if solution is None:
+            return math.inf
+        return sum((y - sum(a * b for a, b in zip(x, solution, strict=True))) ** 2 for x, y in rows)
+
+    scan = range(int(max(RINGING_LOW_HZ, round(0.5 * peak))), int(1.2 * peak) + 1)
+    best = min(scan, key=misfit, default=scan.start)
+    return 0.0 if best in (scan.start, scan.stop - 1) else float(best)  # at an edge: no sine there, not a resonance
 
 
 class _PlateauStage(_Stage):
@@ -210,12 +247,13 @@ class _PlateauStage(_Stage):
         self.model = model
         """J, B, Tc, Tg of the first run: the second run feeds them forward, so its plateaus are steady."""
         kt = tuning.torque_constant
-        omega = 2.0 * math.pi * LOOP_HZ
+        self.hold, self.average, loop_hz = _timing(tuning.resonance_hz)
+        omega = 2.0 * math.pi * loop_hz
         self.kp = inertia * omega / kt
         self.ki = self.kp * omega / 4.0
         self.integral = 0.0
-        self.ramp, self.low = _plan(inertia, kt * tuning.current)
-        self.segments = _profile(self.ramp, self.low)
+        self.ramp, self.low = _plan(inertia, kt * tuning.swing, self.hold)
+        self.segments = _profile(self.ramp, self.low, self.hold)
         self.pass_time = sum(length for length, _, _ in self.segments)
         self.period = 0
         self.directions: list[int] = []
@@ -237,13 +275,14 @@ class _PlateauStage(_Stage):
         return self.kp * error + self.ki * self.integral + self._feed_forward(direction, reference, acceleration), None
 
     def _feed_forward(self, direction: int, speed: float, acceleration: float) -> float:
-        """Current for the profile from the model known so far (J0 and the coast friction; then the first fit)."""
+        """Current for the profile from the model known so far (J0, the coast friction and the holding current;
+        then the first fit, whose constant load torque also holds the axis at rest)."""
         moving = 1.0 if speed > 0.0 else 0.0
         if self.model is None:
             torque = direction * (self.inertia * acceleration + self.friction * moving)
-        else:
-            inertia, viscous, coulomb, load = self.model
-            torque = direction * (inertia * acceleration + viscous * speed + coulomb * moving) + load * moving
+            return torque / self.tuning.torque_constant + self.tuning.bias
+        inertia, viscous, coulomb, load = self.model
+        torque = direction * (inertia * acceleration + viscous * speed + coulomb * moving) + load
         return torque / self.tuning.torque_constant
 
     def _finish(self) -> bool | _Stage:
@@ -270,7 +309,7 @@ class _PlateauStage(_Stage):
             base = index * self.pass_time
             holds = _hold_windows(self.segments, base)
             for start, end in holds:
-                rows.append(self._row(start + AVERAGE, end - AVERAGE, direction, dt))
+                rows.append(self._row(start + self.average, end - self.average, direction, dt))
             for (a, b), (c, d) in itertools.pairwise(holds):
                 rows.append(self._row((a + b) / 2, (c + d) / 2, direction, dt))
         return rows
@@ -284,10 +323,10 @@ class _PlateauStage(_Stage):
         return [acceleration, speed, float(direction), 1.0], torque
 
     def _speed(self, n: int) -> float:
-        """Speed at period n: slope of a cubic fitted to the positions within ±AVERAGE (unbiased by a changing
+        """Speed at period n: slope of a cubic fitted to the positions within ±average (unbiased by a changing
         acceleration, and the fit averages the sensor's quantisation)."""
         dt = self.tuning.dt
-        width = round(AVERAGE / dt)
+        width = round(self.average / dt)
         centre = self.positions[n]
         rows = [
             ([1.0, k * dt, (k * dt) ** 2, (k * dt) ** 3], self.positions[n + k] - centre)
@@ -297,21 +336,32 @@ class _PlateauStage(_Stage):
         return solution[1] if solution else 0.0
 
 
-def _plan(inertia: float, torque: float) -> tuple[float, float]:
+def _timing(resonance_hz: float) -> tuple[float, float, float]:
+    """Plateau length, end-speed half-window (s) and soft-loop frequency (Hz) for the resonance seen (0 = none)."""
+    if resonance_hz <= 0.0:
+        return HOLD, AVERAGE, LOOP_HZ
+    return (
+        max(HOLD, HOLD_PERIODS / resonance_hz),
+        max(AVERAGE, 1.0 / resonance_hz),
+        min(LOOP_HZ, SOFT_SHARE * resonance_hz),
+    )
+
+
+def _plan(inertia: float, torque: float, hold: float) -> tuple[float, float]:
     """Ramp time and low plateau speed: the pass travels TRAVEL, the ramps stay within ACCELERATION_SHARE."""
     # travel = ω1·(5·ramp + 5·hold); peak acceleration of a cycloidal ramp of 2·ω1 = 4·ω1/ramp
     limit = ACCELERATION_SHARE * torque / inertia
     # ramp·(ramp + hold) ≥ 4·TRAVEL / (5·limit)
     need = 4.0 * TRAVEL / (5.0 * limit)
-    ramp = max(RAMP_MIN, (-HOLD + math.sqrt(HOLD * HOLD + 4.0 * need)) / 2.0)
-    return ramp, TRAVEL / (5.0 * (ramp + HOLD))
+    ramp = max(RAMP_MIN, (-hold + math.sqrt(hold * hold + 4.0 * need)) / 2.0)
+    return ramp, TRAVEL / (5.0 * (ramp + hold))
 
 
-def _profile(ramp: float, low: float) -> list[tuple[float, float, float]]:
+def _profile(ramp: float, low: float, hold: float) -> list[tuple[float, float, float]]:
     """Segments (length, start speed, end speed) of one pass: 0 → ω1 → 3ω1 → ω1 → 0, with holds and a rest."""
     high = 3.0 * low
-    levels = [(ramp, 0.0, low), (HOLD, low, low), (ramp, low, high), (HOLD, high, high)]
-    levels += [(ramp, high, low), (HOLD, low, low), (ramp, low, 0.0), (REST, 0.0, 0.0)]
+    levels = [(ramp, 0.0, low), (hold, low, low), (ramp, low, high), (hold, high, high)]
+    levels += [(ramp, high, low), (hold, low, low), (ramp, low, 0.0), (REST, 0.0, 0.0)]
     return levels
 
 
