@@ -49,7 +49,8 @@ def imported_top_names(folder: Path) -> set[str]:
                 names |= {alias.name.split(".")[0] for alias in node.names}
             elif isinstance(node, ast.ImportFrom) and node.level == 0 and node.module:
                 names.add(node.module.split(".")[0])
-    return names - set(sys.stdlib_module_names) - OWN_MODULES - {"__future__"}
+    siblings = {path.stem for path in folder.glob("*.py")}  # a script importing its neighbour (bench/ helpers)
+    return names - set(sys.stdlib_module_names) - OWN_MODULES - siblings - {"__future__"}
 
 
 def imported_distributions(folder: Path) -> set[str]:

@@ -20,6 +20,9 @@ const AXIS_VIEWS: Record<string, AxisView> = {
   "go-commissioning": "commissioning",
   "go-backup": "backup",
   "go-scope": "scope",
+  "go-current-loop": "current-loop",
+  "go-phasing": "phasing",
+  "go-tuning": "tuning",
 };
 
 /** Listen to the keyboard: shortcuts are ignored while typing in a field, where Escape leaves the field. */

@@ -14,7 +14,7 @@ from servostudio.api.app import Settings
 from servostudio.api.limits import DEFAULT_BODY_BYTES
 from servostudio.api.routes.backup import DRIVE_FILE_BYTES
 from servostudio.api.routes.dictionaries import EDS_UPLOAD_BYTES
-from servostudio.api.routes.projects import ARCHIVE_UPLOAD_BYTES
+from servostudio.api.routes.projects import ARCHIVE_UPLOAD_BYTES, DCF_UPLOAD_BYTES
 
 FILES = "/api/buses/sim/nodes/1/files"
 JOB_KEYS = {"id", "operation", "state", "result", "error", "started", "finished"}
@@ -88,6 +88,7 @@ def _call(app, method: str, path: str, length: int | None, chunks: list[bytes]) 
         ("POST", "/api/dictionaries", EDS_UPLOAD_BYTES),
         ("PUT", f"{FILES}/DRIVEPAR.TXT", DRIVE_FILE_BYTES),
         ("POST", "/api/projects/unarchive", ARCHIVE_UPLOAD_BYTES),
+        ("POST", "/api/projects/p/axes/X/dcf", DCF_UPLOAD_BYTES),
         ("POST", "/api/projects", DEFAULT_BODY_BYTES),
     ],
 )

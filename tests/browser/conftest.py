@@ -68,6 +68,7 @@ class DemoServer:
     project: str
     bus: str
     axes: tuple[tuple[str, int], ...]  # (axis name, node ID)
+    projects_dir: Path | None = None  # the server's project store (tests may save records there, as the server would)
 
     def api(self, method: str, path: str, **kwargs) -> httpx.Response:
         response = httpx.request(method, self.url + path, timeout=15.0, **kwargs)
@@ -104,7 +105,8 @@ def demo_server(tmp_path_factory: pytest.TempPathFactory):
             match = httpx.post(
                 f"{server.url}/api/buses", json={"spec": bus["interface"], "id": bus["name"]}, timeout=30.0
             ).json()
-        yield DemoServer(server.url, "demo", match["id"], tuple((a["name"], a["node_id"]) for a in project["axes"]))
+        axes = tuple((a["name"], a["node_id"]) for a in project["axes"])
+        yield DemoServer(server.url, "demo", match["id"], axes, projects)
     finally:
         server.stop()
 

@@ -218,6 +218,15 @@ def test_auto_tuning_from_the_ui_identifies_the_plant_verifies_and_undoes(page: 
     expect(page.get_by_test_id("verify-speed-rise")).to_have_text(re.compile(r"ms$"))
     expect(page.get_by_test_id("verify-speed-overshoot")).to_have_text(re.compile(r"%$"))
     expect(page.get_by_test_id("verify-speed-settling")).to_have_text(re.compile(r"ms$"))
+    # measured from the two recorded speed steps (their mean frequency response), not from the tuning formula; this
+    # rig's plant is a two-mass axis (anti-resonance near 87 Hz): its loop reaches about 53 Hz of the 75 requested
+    # (the simulator's shaft speed says the same), so the page is judged on showing the measurement, the bandwidth
+    # itself on rigid plants in tests/services/procedures/test_procedures_plants.py
+    shown = page.get_by_test_id("verify-speed-bandwidth")
+    row = page.get_by_test_id("verify-speed").locator("tr").filter(has=shown)
+    expect(row).to_contain_text(re.compile(r"\([12] of 2 steps\)"))
+    expect(shown).to_have_text(re.compile(r"^\d+(\.\d+)? Hz$"))
+    expect(page.get_by_test_id("verify-position-plot")).to_have_attribute("data-drawn", re.compile(r"^\d+$"))
     saved = page.get_by_test_id("saved-results").get_by_test_id("saved-row").first
     expect(saved).to_contain_text("auto_tuning")
     screenshot(page, "procedures-tuning")

@@ -10,7 +10,6 @@ stops on them, dcfchk accepts them).
 
 from __future__ import annotations
 
-import re
 import subprocess
 import sys
 from pathlib import Path
@@ -18,15 +17,22 @@ from pathlib import Path
 import canopen
 import dcf
 import pytest
-from canopen.objectdictionary import ODVariable
+from tests.od.peers import (
+    NODE,
+    as_dcf_tools_value,
+    canopen_configured,
+    canopen_copy,
+    canopen_entry,
+    canopen_view,
+    compact_indices,
+    our_view,
+)
 
-from servostudio.od import Variable, load_dictionary
-from servostudio.od.ini import read_ini
+from servostudio.od import load_dictionary
 
 REPO = Path(__file__).resolve().parents[2]
 CORPUS = sorted((REPO / "tests" / "od" / "corpus").glob("*.[ed][dc][sf]")) + sorted((REPO / "eds").glob("*.eds"))
 DCFCHK = Path(sys.executable).parent / "dcfchk"
-NODE = 5
 
 
 def test_the_corpus_has_files_of_other_tools() -> None:
@@ -41,63 +47,29 @@ def test_dcfchk_accepts_the_file(path: Path) -> None:
     assert (result.returncode, result.stderr) == (0, "")
 
 
-def _canopen_copy(path: Path, tmp_path: Path) -> Path:
-    """The file as canopen 2.4 can read it: without empty [DeviceInfo] numbers (it stops on them)."""
-    text = re.sub(
-        r"^(VendorNumber|ProductNumber|RevisionNumber)=\s*$\n", "", path.read_text(encoding="latin-1"), flags=re.M
-    )
-    copy = tmp_path / path.name
-    copy.write_text(text, encoding="latin-1")
-    return copy
-
-
-def _compact_indices(path: Path) -> set[int]:
-    """The objects the file writes with CompactSubObj."""
-    ini = read_ini(path)
-    return {int(section.name, 16) for section in ini if len(section.name) == 4 and section.get("CompactSubObj")}
-
-
-def _canopen_entry(theirs: canopen.ObjectDictionary, variable: Variable) -> ODVariable:
-    entry = theirs[variable.index]
-    return entry if isinstance(entry, ODVariable) else entry[variable.subindex]
-
-
-def _canopen_view(entry: ODVariable) -> tuple:
-    return (entry.name, entry.data_type, entry.access_type, entry.pdo_mappable, entry.min, entry.max)
-
-
-def _our_view(variable: Variable) -> tuple:
-    access = variable.access.value
-    return (variable.name, int(variable.data_type), access, variable.pdo_mappable, variable.low, variable.high)
-
-
 @pytest.mark.parametrize("path", CORPUS, ids=[path.name for path in CORPUS])
 def test_canopen_reads_the_same_entries(path: Path, tmp_path: Path) -> None:
     ours = load_dictionary(path)
-    theirs = canopen.import_od(str(_canopen_copy(path, tmp_path)), node_id=NODE)
-    compact = _compact_indices(path)
+    theirs = canopen.import_od(str(canopen_copy(path, tmp_path)), node_id=NODE)
+    compact = compact_indices(path)
     compared = 0
     for variable in ours.variables():
         if variable.index in compact:
             continue
-        entry = _canopen_entry(theirs, variable)
-        assert _our_view(variable) == _canopen_view(entry), variable.label
+        entry = canopen_entry(theirs, variable)
+        assert our_view(variable) == canopen_view(entry), variable.label
         if not variable.data_type.is_time:
             assert variable.default_for(NODE) == entry.default, variable.label
-            assert variable.parameter_value_for(NODE) == _canopen_configured(entry), variable.label
+            assert variable.parameter_value_for(NODE) == canopen_configured(entry), variable.label
         compared += 1
     assert compared > 0
-
-
-def _canopen_configured(entry: ODVariable) -> object:
-    return entry.value if getattr(entry, "value_raw", None) not in (None, "") else None
 
 
 @pytest.mark.parametrize("path", CORPUS, ids=[path.name for path in CORPUS])
 def test_dcf_tools_reads_the_same_compact_and_time_entries(path: Path) -> None:
     ours = load_dictionary(path)
     device = dcf.Device(dcf.parse_file(str(path)), {"NODEID": NODE})
-    compact = _compact_indices(path)
+    compact = compact_indices(path)
     for variable in ours.variables():
         if not (variable.index in compact or variable.data_type.is_time):
             continue
@@ -111,11 +83,4 @@ def test_dcf_tools_reads_the_same_compact_and_time_entries(path: Path) -> None:
         expected = variable.parameter_value_for(NODE)
         if expected is None:
             expected = variable.default_for(NODE) or 0
-        assert _as_dcf_tools_value(variable, expected) == entry.parse_value(), variable.label
-
-
-def _as_dcf_tools_value(variable: Variable, value: object) -> object:
-    """dcf-tools keeps TIME values as (days, ms)."""
-    if variable.data_type.is_time and isinstance(value, int):
-        return (value >> 32, value & 0xFFFFFFFF)
-    return value
+        assert as_dcf_tools_value(variable, expected) == entry.parse_value(), variable.label

@@ -12,8 +12,11 @@ import sys
 from pathlib import Path
 
 from servostudio.cli import audit, drive, eds, project, remote, seq, token, user
+from servostudio.cli import frequency as frequency_cli
+from servostudio.cli import identify as identify_cli
 from servostudio.cli import motion as motion_cli
 from servostudio.cli import procedures as procedures_cli
+from servostudio.cli import report as report_cli
 from servostudio.cli import scope as scope_cli
 from servostudio.cli import sim as sim_cli
 from servostudio.cli.output import crashed, refused
@@ -38,9 +41,12 @@ def build_parser() -> argparse.ArgumentParser:
     drive.register(commands)
     motion_cli.register(commands)
     procedures_cli.register(commands)
+    frequency_cli.register(commands)
+    identify_cli.register(commands)
     scope_cli.register(commands)
     seq.register(commands)
     audit.register(commands)
+    report_cli.register(commands)
     sim_cli.register(commands)
     return parser
 

@@ -1,4 +1,4 @@
-"""Drive commands: ``servostudio scan|read|write|backup|restore|nmt|fault|state --bus SPEC [--node N] …``.
+"""Drive commands: ``servostudio scan|read|write|backup|restore|nmt|fault|state|io --bus SPEC [--node N] …``.
 
 Through a running server (``--server URL``, ``$SERVOSTUDIO_SERVER`` or the config file: ``cli.remote``) each
 command is the server's REST calls (``cli.server_drive``); with ``--bus`` alone it opens the bus itself (headless).
@@ -16,7 +16,7 @@ import threading
 from collections.abc import Callable, Sequence
 from pathlib import Path
 
-from servostudio.cli import remote, server_drive
+from servostudio.cli import io_changes, remote, server_drive
 from servostudio.cli.audit import audit_log, guarded_connections, local_actor
 from servostudio.cli.output import emit
 from servostudio.drive.access import Drive
@@ -24,6 +24,7 @@ from servostudio.drive.cia402 import State
 from servostudio.drive.control import fault_report, read_state, reset_faults, set_state
 from servostudio.drive.link import LinkDownError
 from servostudio.errors import InvalidInput
+from servostudio.services import io
 from servostudio.services.audit import acting_as
 from servostudio.services.backup import (
     BackupError,
@@ -111,6 +112,31 @@ def register(commands: argparse._SubParsersAction) -> None:
         nargs="?",
         help="switch-on-disabled, ready-to-switch-on, switched-on, operation-enabled, quick-stop-active",
     )
+    io_command = add(
+        "io",
+        "show the I/O configuration, its live state and the fail-safe findings; --input/--output/--set change it "
+        "(the whole change checked before anything is written)",
+        _io,
+        server_drive.io,
+    )
+    io_command.add_argument(
+        "--input",
+        dest="inputs",
+        action="append",
+        default=[],
+        metavar="NAME=FUNCTION[:inverted|:normal]",
+        help="a logic input's function / polarity",
+    )
+    io_command.add_argument(
+        "--output",
+        dest="outputs",
+        action="append",
+        default=[],
+        metavar="NAME=FUNCTION[:inverted|:normal]",
+        help="an output's function / polarity",
+    )
+    io_command.add_argument("--set", dest="settings", action="append", default=[], metavar="KEY=VALUE",
+                            help="an I/O setting (analog scaling, encoder emulation …)")  # fmt: skip
     share = add(
         "share",
         "share a bus of the running server as a socketcand endpoint for your own CANopen scripts (loopback only)",
@@ -246,6 +272,13 @@ def restore_failure(result: dict) -> str:
     problems = result.get("objects") or []
     detail = "; ".join(f"{item['label']}: {item['status']} {item['error']}".strip() for item in problems[:5])
     return f"restore of node {result['node']} incomplete: {result.get('error') or detail}"
+
+
+def _io(args: argparse.Namespace, connection: BusConnection) -> object:
+    drive, simulated = _drive(args, connection), connection.simulation is not None
+    if not io_changes.asks_a_change(args):
+        return io.read(drive, simulated)
+    return io.apply(drive, io_changes.change_of(args), simulated)
 
 
 def _nmt(args: argparse.Namespace, connection: BusConnection) -> object:

@@ -16,6 +16,7 @@ from servostudio.cli.audit import audit_log, guarded_connections, local_actor
 from servostudio.cli.output import emit
 from servostudio.errors import CommunicationError, InvalidInput, NotFound
 from servostudio.od import EdsLibrary
+from servostudio.services import dictionaries
 from servostudio.services.audit import acting_as
 from servostudio.services.projects import Axis, Bus, DriveMismatch, ProjectService
 from servostudio.services.projects.fsutil import atomic_write
@@ -27,6 +28,7 @@ from servostudio.services.projects.jsonview import (
     project_view,
     summaries,
     template_view,
+    value_change_view,
 )
 from servostudio.services.projects.live import LiveProjects
 from servostudio.services.projects.motors import motor_from_text
@@ -192,6 +194,7 @@ def register(commands: argparse._SubParsersAction) -> None:
     dcf_import.add_argument("name")
     dcf_import.add_argument("axis")
     dcf_import.add_argument("dcf", type=Path)
+    dcf_import.add_argument("--dry-run", action="store_true", help="check it and say what would change; write nothing")
     revision(dcf_import)
     action(
         "revisions", _revisions, "kept revisions: the project before each change that replaced many values"
@@ -431,9 +434,17 @@ def _dcf(service: ProjectService, args: argparse.Namespace) -> dict:
 
 
 def _dcf_import(service: ProjectService, args: argparse.Namespace) -> dict:
-    imported = service.import_dcf(args.name, args.axis, args.dcf, args.revision)
-    rows = [parameter_view(row) for row in imported.change.rows]
-    return {"parameters": rows, "skipped": imported.skipped, "revision": imported.change.revision}
+    text = dictionaries.read_file_text(args.dcf)
+    if args.dry_run:
+        imported = service.preview_dcf(args.name, args.axis, text, str(args.dcf))
+    else:
+        imported = service.import_dcf(args.name, args.axis, text, str(args.dcf), args.revision)
+    return {
+        "parameters": [parameter_view(row) for row in imported.change.rows],
+        "changes": [value_change_view(change) for change in imported.changes],
+        "skipped": imported.skipped,
+        "revision": imported.change.revision,
+    }
 
 
 def _motor_list(service: ProjectService, args: argparse.Namespace) -> list[dict]:

@@ -20,6 +20,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from servostudio.cli import io_changes
 from servostudio.cli.output import emit
 from servostudio.cli.remote import Remote, quoted
 from servostudio.drive.cia402 import State
@@ -100,6 +101,12 @@ def fault(args: argparse.Namespace, bus: ServerBus) -> object:
     if args.reset:
         return bus.call("POST", bus.path(args.node, f"/faults/reset{_device(args)}"))
     return bus.call("GET", bus.path(args.node, f"/faults{_device(args)}"))
+
+
+def io(args: argparse.Namespace, bus: ServerBus) -> object:
+    if not io_changes.asks_a_change(args):
+        return bus.call("GET", bus.path(args.node, f"/io{_device(args)}"))
+    return bus.call("PUT", bus.path(args.node, f"/io{_device(args)}"), io_changes.change_body(args))
 
 
 def state(args: argparse.Namespace, bus: ServerBus) -> object:

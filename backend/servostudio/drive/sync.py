@@ -31,14 +31,23 @@ HOLD_SECONDS = 2e-4
 class SyncProducer:
     """SYNC frames every ``period_s`` until stopped (or a lost link ends them)."""
 
-    def __init__(self, link: BusLink, period_s: float, answered: Callable[[], int] | None = None) -> None:
-        if period_s < MIN_PERIOD_S:
-            raise ValueError(f"SYNC period {period_s * 1e6:.0f} µs below {MIN_PERIOD_S * 1e6:.0f} µs")
+    def __init__(
+        self,
+        link: BusLink,
+        period_s: float,
+        answered: Callable[[], int] | None = None,
+        before: Callable[[int], None] | None = None,
+        minimum_s: float = MIN_PERIOD_S,
+    ) -> None:
+        if period_s < minimum_s:
+            raise ValueError(f"SYNC period {period_s * 1e6:.0f} µs below {minimum_s * 1e6:.0f} µs")
         self.link = link
         self.period_s = period_s
         self.sent: list[float] = []  # monotonic send instants
         self.error: str | None = None
         self._answered = answered
+        #: called with k just before SYNC k is sent (the frequency response's RPDO, applied at that SYNC)
+        self._before = before
         self._stop = threading.Event()
         self._thread = threading.Thread(target=self._run, name=f"sync {link.name}", daemon=True)
 
@@ -73,6 +82,8 @@ class SyncProducer:
                 if self._stop.wait(HOLD_SECONDS):
                     return
             try:
+                if self._before is not None:
+                    self._before(k)
                 self.link.send(SYNC_COB_ID, b"")
             except LinkDownError as error:
                 self.error = str(error)

@@ -4,7 +4,7 @@ See docs/eds.md for the file formats.
 """
 
 from servostudio.od.datatypes import DataType, EncodingError, decode, encode
-from servostudio.od.eds import load_dictionary
+from servostudio.od.eds import load_dictionary, parse_dictionary
 from servostudio.od.library import BUILTIN_EDS_DIR, EdsLibrary, LibraryError, builtin_library
 from servostudio.od.model import (
     Access,
@@ -41,4 +41,5 @@ __all__ = [
     "decode",
     "encode",
     "load_dictionary",
+    "parse_dictionary",
 ]

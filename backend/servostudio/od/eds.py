@@ -12,7 +12,7 @@ from pathlib import Path
 
 from servostudio.od.datatypes import DataType
 from servostudio.od.eds_values import ValueSyntaxError, parse_integer, parse_number, parse_value
-from servostudio.od.ini import IniEntry, IniFile, IniSection, read_ini
+from servostudio.od.ini import IniEntry, IniFile, IniSection, parse_ini, read_ini
 from servostudio.od.model import (
     Access,
     DictionaryError,
@@ -79,13 +79,26 @@ def load_dictionary(eds_path: Path, props_path: Path | None = None) -> ObjectDic
     info = reader.device_info(objects[0x1018])
     if props_path is not None:
         objects = apply_props(read_ini(Path(props_path)), objects)
+    return _dictionary(eds_path, info, objects)
+
+
+def parse_dictionary(text: str, name: str) -> ObjectDictionary:
+    """Read an EDS or DCF from its text (an upload); ``name`` is the file's name as the user knows it, and is the
+    only file name its errors give (no server path)."""
+    source = Path(name)
+    reader = _EdsReader(parse_ini(text, source))
+    objects = reader.objects()
+    return _dictionary(source, reader.device_info(objects[0x1018]), objects)
+
+
+def _dictionary(source: Path, info: DeviceInfo, objects: dict[int, DictObject]) -> ObjectDictionary:
     return ObjectDictionary(
-        device=eds_path.stem.lower(),
+        device=source.stem.lower(),
         product_name=info.product_name,
         vendor_id=info.vendor_id,
         product_code=info.product_code,
         revision=info.revision,
-        source=eds_path,
+        source=source,
         objects=list(objects.values()),
     )
 

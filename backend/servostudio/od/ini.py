@@ -95,12 +95,15 @@ class IniFile:
 def read_ini(path: Path) -> IniFile:
     """Read and parse an INI file (UTF-8, with or without BOM; Windows-1252 accepted as a fallback)."""
     path = Path(path)
-    raw = path.read_bytes()
+    return parse_ini(decode_ini(path.read_bytes()), path)
+
+
+def decode_ini(raw: bytes) -> str:
+    """The text of an INI file's bytes: UTF-8 (with or without BOM), else Windows-1252 (what older tools write)."""
     try:
-        text = raw.decode("utf-8-sig")
+        return raw.decode("utf-8-sig")
     except UnicodeDecodeError:
-        text = raw.decode("cp1252", errors="replace")
-    return parse_ini(text, path)
+        return raw.decode("cp1252", errors="replace")
 
 
 def parse_ini(text: str, path: Path) -> IniFile:

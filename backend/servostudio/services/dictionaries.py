@@ -9,6 +9,7 @@ from pathlib import Path
 
 from servostudio.errors import InvalidInput, NotFound
 from servostudio.od import EdsLibrary, LibraryError, ObjectDictionary, Variable, load_dictionary
+from servostudio.od.ini import decode_ini
 
 
 class UnknownDictionary(NotFound):
@@ -49,6 +50,20 @@ def check_file(eds: Path, props: Path | None = None) -> ObjectDictionary:
         return load_dictionary(eds, props)
     except OSError as error:
         raise InvalidInput(f"{error.filename}: {error.strerror}") from None
+
+
+def read_file_text(path: Path) -> str:
+    """The text of an EDS or DCF the user named (the CLI), decoded as the loader decodes files; a file that cannot
+    be read is refused input."""
+    try:
+        return decode_ini(Path(path).read_bytes())
+    except OSError as error:
+        raise InvalidInput(f"{error.filename}: {error.strerror}") from None
+
+
+def upload_text(raw: bytes) -> str:
+    """The text of an uploaded EDS or DCF, decoded as the loader decodes files."""
+    return decode_ini(raw)
 
 
 def import_file(library: EdsLibrary, eds: Path, props: Path | None = None) -> str:

@@ -17,7 +17,7 @@ beforeAll(() => {
 beforeEach(() => localStorage.clear());
 
 const kpv = entry(0x60f9, { subindex: 2, name: "KPv", group: "Servo Loops" }, { name: "Speed loop", kind: "RECORD" });
-const kiv = entry(0x60f9, { subindex: 3, name: "KIv", group: "Servo Loops" }, { name: "Speed loop", kind: "RECORD" });
+const kiv = entry(0x60f9, { subindex: 3, name: "KIv", group: "Servo Loops", write_level: "expert" }, { name: "Speed loop", kind: "RECORD" });
 const rated = entry(0x6075, { name: "Motor rated current", group: "Motor", unit: "A", scale: 0.001, data_type: "INTEGER32" });
 kiv.object = kpv.object;
 kpv.object.subs = [kpv.variable, kiv.variable];
@@ -85,6 +85,21 @@ describe("parameter editor", () => {
     expect(sources.drive!.write).toHaveBeenCalledWith(kiv, 77);
     expect(sources.project!.write).toHaveBeenCalledWith([{ entry: kiv, raw: 77 }]);
     expect(find(element, "detail-drive-value")!.textContent).toBe("77");
+    view.dispose();
+  });
+
+  it("shows the user level an entry needs to be written, and read-only for one nobody writes", async () => {
+    const { view, element } = editor({ q: "KIv" });
+    await view.start();
+    rowOf(element, "0x60F9.3")!.click();
+    expect(find(element, "detail-write-level")!.textContent).toBe("Expert or higher");
+    const statusword = entry(0x6041, { name: "Statusword", access: "ro", write_level: null });
+    const levels = new ParameterEditor({ groups: ["General"], objects: [statusword.object] } as Dictionary, { drive: null, project: null, onQuery: vi.fn() },
+      { route: { page: "axis" }, query: {} } as unknown as Location);
+    document.body.replaceChildren(levels.element);
+    await levels.start();
+    expect(find(levels.element, "detail-write-level")!.textContent).toBe("read-only");
+    levels.dispose();
     view.dispose();
   });
 

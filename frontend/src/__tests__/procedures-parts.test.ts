@@ -108,6 +108,11 @@ describe("verification step figure", () => {
     expect((figure.layout.shapes as { x0: number }[])[0].x0).toBe(0.01);
     expect(stepFigures(step).map(([, , value]) => value)).toEqual(["4 ms", "—", "10 ms", "—"]);
   });
+
+  it("says how many of the repeated speed steps the bandwidth comes from", () => {
+    const repeated = { ...step, bandwidth_hz: 74.2, bandwidth_steps_hz: [73.0, null] };
+    expect(stepFigures(repeated)[3]).toEqual(["bandwidth", "−3 dB bandwidth (1 of 2 steps)", "74.2 Hz"]);
+  });
 });
 
 const dictionary = {

@@ -33,4 +33,15 @@ describe("shortcuts", () => {
     expect(window.location.pathname).toBe("/projects/demo/axes/X/parameters");
     expect(runAction(app, "unknown")).toBe(false);
   });
+
+  it("g l, g f and g u open the current loop, phasing and auto-tuning of the axis shown", () => {
+    vi.stubGlobal("fetch", vi.fn(async () => Response.json({ detail: "not in this test" }, { status: 404 })));
+    history.replaceState(null, "", "/projects/demo/axes/Y/dashboard");
+    const app = new App(document.createElement("div"));
+    app.projects.val = [demo];
+    for (const [action, view] of [["go-current-loop", "current-loop"], ["go-phasing", "phasing"], ["go-tuning", "tuning"]]) {
+      expect(runAction(app, action)).toBe(true);
+      expect(window.location.pathname).toBe(`/projects/demo/axes/Y/${view}`);
+    }
+  });
 });

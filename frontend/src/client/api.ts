@@ -176,6 +176,7 @@ export type Motor = Schemas["MotorModel"];
 export type AxisChoice = Schemas["AxisChoiceModel"];
 export type Template = Schemas["TemplateModel"];
 export type KeptRevision = Schemas["KeptRevisionModel"];
+export type DcfImport = Schemas["DcfImportModel"];
 type ProjectChange = Schemas["ProjectUpdate"];
 type AxisChange = Schemas["AxisUpdate"];
 
@@ -227,6 +228,13 @@ export const projects = {
   applyApplication: (project: string, axis: string, template: string, revision: string) =>
     post<AxisChoice>(`${axisPath(project, axis)}/application`, { template, revision }),
   dcfUrl: (project: string, axis: string) => `${axisPath(project, axis)}/dcf`,
+  /** Set the axis's offline values to what a DCF configures (all or nothing); `changes` says what changes (old,
+   * new), `skipped` what it left out. With `dryRun` the server checks it all and writes nothing. */
+  importDcf: (project: string, axis: string, dcf: File, revision: string, dryRun = false) => {
+    const form = new FormData();
+    form.append("dcf", dcf);
+    return post<DcfImport>(`${axisPath(project, axis)}/dcf?revision=${e(revision)}&dry_run=${dryRun}`, form);
+  },
   templates: (device: string) => get<Template[]>(`/api/device-templates?device=${e(device)}`),
   motors: () => get<Motor[]>("/api/motors"),
 };

@@ -46,20 +46,30 @@ export type BusMatch = Schemas["BusMatchModel"];
 /** The server's answer per project bus name: which open bus it is and by what (spec, name); the project page shows it. */
 export const busMatches: State<ReadonlyMap<string, BusMatch>> = state(new Map());
 let matchRequests = 0;
+/** The question whose answer the mapping holds. */
+let appliedRequest = 0;
 
 export function learnBuses(server: BusInfo[], projectBuses: { name: string; interface: string }[]): void {
+  const open = new Set(server.map((candidate) => candidate.id));
   const next = new Map<string, string>();
   for (const bus of projectBuses) {
+    // While the server is asked again, its last answer stands for a bus that is still open: a guess from the spelling
+    // of the spec would send the calls made meanwhile to a bus that does not exist.
+    const decided = aliases.rawVal.get(bus.name);
     const match = server.find((candidate) => candidate.id === bus.name) ?? server.find((candidate) => candidate.spec === bus.interface);
-    if (match) next.set(bus.name, match.id);
+    const id = decided !== undefined && open.has(decided) ? decided : match?.id;
+    if (id) next.set(bus.name, id);
   }
   aliases.val = next;
   const asked = ++matchRequests;
   if (server.length === 0 || projectBuses.length === 0) return learned();
   // The server compares specs as it parses them (`socketcand:h:p` is `socketcand:h:p/can0`): its answer decides.
+  // Answers are applied in the order of the questions (one that comes after a later question's answer is dropped),
+  // and drive calls wait until an answer is applied: never released by an answer that was dropped.
   void post<BusMatch[]>("/api/buses/match", { buses: projectBuses.map((bus) => ({ name: bus.name, spec: bus.interface })) })
     .then((matches) => {
-      if (asked !== matchRequests) return; // a later call asked again: its answer counts
+      if (asked < appliedRequest) return;
+      appliedRequest = asked;
       aliases.val = new Map(matches.flatMap((match) => (match.bus ? [[match.name, match.bus] as [string, string]] : [])));
       busMatches.val = new Map(matches.map((match) => [match.name, match]));
     }, () => undefined)

@@ -62,6 +62,8 @@ export interface StepMeasure {
   overshoot_pct: number | null;
   settling_time_s: number | null;
   bandwidth_hz: number | null;
+  /** The speed steps' own bandwidths (null: that step did not settle); `bandwidth_hz` is their mean response's. */
+  bandwidth_steps_hz?: (number | null)[];
   capture: { time_s: number[]; reference: number[]; response: number[]; unit: string };
 }
 

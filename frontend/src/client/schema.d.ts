@@ -266,6 +266,104 @@ export interface paths {
         patch?: never;
         trace?: never;
     };
+    "/api/buses/{bus}/nodes/{node}/frequency-response": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        get?: never;
+        put?: never;
+        /** Measure the plant or the closed speed loop's frequency response as a job (multi-sine by RPDO) */
+        post: operations["start_frequency_response_api_buses__bus__nodes__node__frequency_response_post"];
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
+    "/api/buses/{bus}/nodes/{node}/identification": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        get?: never;
+        put?: never;
+        /** Identify inertia, friction and load with the tool's own experiment, as a job (cancel = quick stop) */
+        post: operations["start_identification_api_buses__bus__nodes__node__identification_post"];
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
+    "/api/buses/{bus}/nodes/{node}/io": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        /**
+         * Read
+         * @description Every input and output with its function and polarity, the settings, the live state and the findings.
+         */
+        get: operations["read_api_buses__bus__nodes__node__io_get"];
+        /**
+         * Change
+         * @description Check the whole change (422 and nothing written on any problem), then write it through the motion guard.
+         */
+        put: operations["change_api_buses__bus__nodes__node__io_put"];
+        post?: never;
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
+    "/api/buses/{bus}/nodes/{node}/io/sim-inputs": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        get?: never;
+        /**
+         * Sim Inputs
+         * @description Simulator only: the test bench's inputs (0x5F00); 409 on a real drive.
+         */
+        put: operations["sim_inputs_api_buses__bus__nodes__node__io_sim_inputs_put"];
+        post?: never;
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
+    "/api/buses/{bus}/nodes/{node}/io/state": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        /**
+         * Live
+         * @description The live I/O alone, cheap enough to poll.
+         */
+        get: operations["live_api_buses__bus__nodes__node__io_state_get"];
+        put?: never;
+        post?: never;
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
     "/api/buses/{bus}/nodes/{node}/motion": {
         parameters: {
             query?: never;
@@ -1277,7 +1375,14 @@ export interface paths {
         /** Export Dcf */
         get: operations["export_dcf_api_projects__name__axes__axis__dcf_get"];
         put?: never;
-        post?: never;
+        /**
+         * Import Dcf
+         * @description Set the axis's offline values to what the DCF configures (``ParameterValue``, ``$NODEID`` resolved for the
+         *     axis), all or nothing, checked like offline edits; ``changes`` lists the values that change (old, new),
+         *     ``skipped`` what the project cannot hold. The project as it was is kept as a revision. Errors name the file as
+         *     uploaded.
+         */
+        post: operations["import_dcf_api_projects__name__axes__axis__dcf_post"];
         delete?: never;
         options?: never;
         head?: never;
@@ -1604,6 +1709,75 @@ export interface paths {
         patch?: never;
         trace?: never;
     };
+    "/api/projects/{project}/axes/{axis}/frequency": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        /** The frequency responses saved under the axis, newest first (a damaged one names its file in `error`) */
+        get: operations["list_saved_api_projects__project__axes__axis__frequency_get"];
+        put?: never;
+        post?: never;
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
+    "/api/projects/{project}/axes/{axis}/frequency/{name}": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        /** A saved frequency response with its points (422 names the file and line of a damaged one) */
+        get: operations["open_saved_api_projects__project__axes__axis__frequency__name__get"];
+        put?: never;
+        post?: never;
+        /** Delete a saved frequency response (changing the project's records needs Expert, like the project) */
+        delete: operations["delete_saved_api_projects__project__axes__axis__frequency__name__delete"];
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
+    "/api/projects/{project}/axes/{axis}/frequency/{name}/csv": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        /** A saved frequency response as CSV: freq_hz,magnitude_db,phase_deg,coherence after # comment lines */
+        get: operations["saved_csv_api_projects__project__axes__axis__frequency__name__csv_get"];
+        put?: never;
+        post?: never;
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
+    "/api/projects/{project}/axes/{axis}/frequency/{name}/html": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        /** A saved frequency response (and those named in `compare`, overlaid) as a standalone HTML file */
+        get: operations["saved_html_api_projects__project__axes__axis__frequency__name__html_get"];
+        put?: never;
+        post?: never;
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
     "/api/projects/{project}/axes/{axis}/procedures": {
         parameters: {
             query?: never;
@@ -1613,6 +1787,23 @@ export interface paths {
         };
         /** The procedure results saved under the axis, newest first */
         get: operations["list_saved_api_projects__project__axes__axis__procedures_get"];
+        put?: never;
+        post?: never;
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
+    "/api/projects/{project}/report": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        /** The commissioning report of the project (or of one axis) as a standalone HTML download */
+        get: operations["get_report_api_projects__project__report_get"];
         put?: never;
         post?: never;
         delete?: never;
@@ -2015,6 +2206,14 @@ export interface components {
             /** Value */
             value: number;
         };
+        /** Body_import_dcf_api_projects__name__axes__axis__dcf_post */
+        Body_import_dcf_api_projects__name__axes__axis__dcf_post: {
+            /**
+             * Dcf
+             * @description CiA 306 DCF of the axis's device
+             */
+            dcf: string;
+        };
         /** Body_import_dictionary_api_dictionaries_post */
         Body_import_dictionary_api_dictionaries_post: {
             /**
@@ -2344,6 +2543,29 @@ export interface components {
             remaining: number;
             /** Sequence */
             sequence: number;
+        };
+        /** DcfImportModel */
+        DcfImportModel: {
+            /**
+             * Changes
+             * @description the project values that change, old and new
+             */
+            changes: components["schemas"]["ValueChangeModel"][];
+            /**
+             * Parameters
+             * @description the objects the DCF's configured values set
+             */
+            parameters: components["schemas"]["ParameterModel"][];
+            /**
+             * Revision
+             * @description the new revision; with dry_run, the current one (nothing was written)
+             */
+            revision: string;
+            /**
+             * Skipped
+             * @description configured values the project cannot hold, each with its reason
+             */
+            skipped: string[];
         };
         /** DictionaryModel */
         DictionaryModel: {
@@ -2766,6 +2988,75 @@ export interface components {
             /** Sequences */
             sequences: number[];
         };
+        /**
+         * FrequencyStart
+         * @description Measure the plant (torque offset → shaft speed, in (rad/s)/(N·m)) or the closed speed loop (target → shaft
+         *     speed) with a multi-sine; the axis runs at the base speed, within the position window and the current limit.
+         * @example {
+         *       "from_hz": 5,
+         *       "loop": "plant",
+         *       "points": 60,
+         *       "to_hz": 400
+         *     }
+         */
+        FrequencyStart: {
+            /**
+             * Amplitude Pct
+             * @description plant: peak torque offset in % of the rated current (default 50); closed: peak speed excursion in % of the base speed (default 40)
+             */
+            amplitude_pct?: number | null;
+            /** Axis */
+            axis?: string | null;
+            /**
+             * Base Speed Rad S
+             * @description the axis never crosses zero speed
+             * @default 10
+             */
+            base_speed_rad_s: number;
+            /**
+             * Current Limit A
+             * @description above it: quick stop, aborted
+             */
+            current_limit_a?: number | null;
+            /**
+             * From Hz
+             * @default 5
+             */
+            from_hz: number;
+            /**
+             * Loop
+             * @default plant
+             * @enum {string}
+             */
+            loop: "plant" | "closed";
+            /**
+             * Periods
+             * @description excitation periods averaged
+             * @default 4
+             */
+            periods: number;
+            /**
+             * Points
+             * @default 60
+             */
+            points: number;
+            /**
+             * Position Window
+             * @description revolutions the axis may travel
+             * @default 10
+             */
+            position_window: number;
+            /**
+             * Project
+             * @description save the result under this project's axis
+             */
+            project?: string | null;
+            /**
+             * To Hz
+             * @default 400
+             */
+            to_hz: number;
+        };
         /** GraphModel */
         GraphModel: {
             /** Edges */
@@ -2848,6 +3139,59 @@ export interface components {
              */
             method: number;
         };
+        /**
+         * IdentificationOptions
+         * @description The experiment's options; each has a default (docs/identification.md § Experiment).
+         */
+        IdentificationOptions: {
+            /**
+             * Acceleration Rpm S
+             * @description the ramps, rpm/s
+             */
+            acceleration_rpm_s?: number | null;
+            /**
+             * Current Limit Pct
+             * @description current limit, % of the rated current
+             */
+            current_limit_pct?: number | null;
+            /**
+             * Cycles
+             * @description repetitions of the profile
+             */
+            cycles?: number | null;
+            /**
+             * Hold S
+             * @description cruise at the higher speed, s (the lower: twice)
+             */
+            hold_s?: number | null;
+            /**
+             * Position Window Rev
+             * @description revolutions either side of start
+             */
+            position_window_rev?: number | null;
+            /**
+             * Speed Rpm
+             * @description the higher speed held, rpm
+             */
+            speed_rpm?: number | null;
+        };
+        /**
+         * IdentificationStart
+         * @example {
+         *       "options": {
+         *         "position_window_rev": 6,
+         *         "speed_rpm": 800
+         *       }
+         *     }
+         */
+        IdentificationStart: {
+            /**
+             * Bandwidth Hz
+             * @description then tune the speed loop for this bandwidth and verify it by a step
+             */
+            bandwidth_hz?: number | null;
+            options?: components["schemas"]["IdentificationOptions"];
+        };
         /** InputsModel */
         InputsModel: {
             /**
@@ -2873,6 +3217,283 @@ export interface components {
              * @description simulated drive only: IN5..IN1 (0x5F00), e.g. 10000
              */
             sim?: string | null;
+        };
+        /** IoChangeRequest */
+        IoChangeRequest: {
+            /** Inputs */
+            inputs?: components["schemas"]["IoInputChangeModel"][];
+            /** Outputs */
+            outputs?: components["schemas"]["IoOutputChangeModel"][];
+            /**
+             * Settings
+             * @description setting key → value (pointers also as '0x30F80100')
+             */
+            settings?: {
+                [key: string]: number | string;
+            };
+        };
+        /** IoFindingModel */
+        IoFindingModel: {
+            /**
+             * Severity
+             * @enum {string}
+             */
+            severity: "unsafe" | "warning" | "note";
+            /** Subject */
+            subject: string;
+            /** Text */
+            text: string;
+        };
+        /** IoFunctionModel */
+        IoFunctionModel: {
+            /**
+             * Condition Bit
+             * @description the bit of the sequence conditional input 0x3601,3 it feeds
+             */
+            condition_bit: number | null;
+            /**
+             * Key
+             * @example positive_limit
+             */
+            key: string;
+            /** Label */
+            label: string;
+            /**
+             * Limit
+             * @description -1 / +1: the negative / positive limit switch, 0: another function
+             */
+            limit: number;
+        };
+        /** IoGroupModel */
+        IoGroupModel: {
+            /** Key */
+            key: string;
+            /** Live */
+            live: components["schemas"]["IoSettingModel"][];
+            /** Settings */
+            settings: components["schemas"]["IoSettingModel"][];
+            /** Title */
+            title: string;
+        };
+        /** IoInputChangeModel */
+        IoInputChangeModel: {
+            /**
+             * Function
+             * @description a key of `functions` / `output_functions`
+             */
+            function?: string | null;
+            /** Inverted */
+            inverted?: boolean | null;
+            /**
+             * Name
+             * @description the input or output as the page names it
+             * @example IN3
+             */
+            name: string;
+        };
+        /** IoInputModel */
+        IoInputModel: {
+            /**
+             * Active
+             * @description the input's state in 0x60FD (after its polarity)
+             */
+            active: boolean | null;
+            /** Allowed */
+            allowed: string[];
+            /**
+             * Bit
+             * @description its bit in the input image 0x60FD
+             */
+            bit: number;
+            /**
+             * Function
+             * @description a function key, or 'other' for a destination no function names
+             */
+            function: string;
+            /**
+             * Inverted
+             * @description the polarity; null: the device has none
+             */
+            inverted: boolean | null;
+            /** Name */
+            name: string;
+            /** Physical */
+            physical: boolean;
+            /**
+             * Pointer
+             * @description the destination pointer (XtrapulsPac 0x3050,n); null elsewhere
+             */
+            pointer: number | null;
+        };
+        /** IoLiveModel */
+        IoLiveModel: {
+            /** Analog */
+            analog: {
+                [key: string]: number | null;
+            };
+            /** Home */
+            home: boolean | null;
+            /** Inhibit */
+            inhibit: boolean | null;
+            /** Input Levels */
+            input_levels: {
+                [key: string]: boolean | null;
+            };
+            /**
+             * Inputs
+             * @description 0x60FD
+             */
+            inputs: number | null;
+            /** Negative Limit */
+            negative_limit: boolean | null;
+            /** Output Levels */
+            output_levels: {
+                [key: string]: boolean | null;
+            };
+            /**
+             * Outputs
+             * @description 0x60FE,1
+             */
+            outputs: number | null;
+            /** Positive Limit */
+            positive_limit: boolean | null;
+            simulated: components["schemas"]["IoSimInputsModel"] | null;
+        };
+        /** IoModel */
+        IoModel: {
+            /** Device */
+            device: string;
+            /**
+             * Findings
+             * @description the fail-safe check of the limit switches, and notes
+             */
+            findings: components["schemas"]["IoFindingModel"][];
+            /** Functions */
+            functions: components["schemas"]["IoFunctionModel"][];
+            /** Groups */
+            groups: components["schemas"]["IoGroupModel"][];
+            /** Inputs */
+            inputs: components["schemas"]["IoInputModel"][];
+            /** Node */
+            node: number;
+            /** Note */
+            note: string;
+            /** Output Functions */
+            output_functions: components["schemas"]["IoFunctionModel"][];
+            /** Outputs */
+            outputs: components["schemas"]["IoOutputModel"][];
+            /**
+             * Routing
+             * @enum {string}
+             */
+            routing: "pointer" | "dedicated" | "fixed";
+            /** @description a simulated drive's test bench inputs (0x5F00) */
+            simulated: components["schemas"]["IoSimInputsModel"] | null;
+            state: components["schemas"]["IoStateModel"];
+            /**
+             * Written
+             * @description after a change: the objects written, in order
+             */
+            written?: string[];
+        };
+        /** IoOutputChangeModel */
+        IoOutputChangeModel: {
+            /**
+             * Function
+             * @description a key of `functions` / `output_functions`
+             */
+            function?: string | null;
+            /** Inverted */
+            inverted?: boolean | null;
+            /**
+             * Name
+             * @description the input or output as the page names it
+             * @example IN3
+             */
+            name: string;
+        };
+        /** IoOutputModel */
+        IoOutputModel: {
+            /** Active */
+            active: boolean | null;
+            /**
+             * Bit
+             * @description its bit in the output image 0x60FE,1
+             */
+            bit: number;
+            /** Function */
+            function: string;
+            /** Inverted */
+            inverted: boolean | null;
+            /** Name */
+            name: string;
+            /** Physical */
+            physical: boolean;
+            /** Pointer */
+            pointer: number | null;
+        };
+        /** IoSettingModel */
+        IoSettingModel: {
+            /**
+             * Address
+             * @example 0x30F1,3
+             */
+            address: string;
+            /** High */
+            high: number | null;
+            /** Key */
+            key: string;
+            /** Label */
+            label: string;
+            /** Low */
+            low: number | null;
+            /**
+             * Pointer
+             * @description a dataflow pointer index << 16 | sub << 8 | bit-or-size
+             */
+            pointer: boolean;
+            /** Value */
+            value: number | null;
+            /** Writable */
+            writable: boolean;
+        };
+        /** IoSimInputsModel */
+        IoSimInputsModel: {
+            /** Meaning */
+            meaning: string;
+            /** Names */
+            names: string[];
+            /** Value */
+            value: number;
+        };
+        /** IoSimInputsRequest */
+        IoSimInputsRequest: {
+            /**
+             * Value
+             * @description bit n: the test bench's input n (see `simulated.names`)
+             */
+            value: number;
+        };
+        /** IoStateModel */
+        IoStateModel: {
+            /** Home */
+            home: boolean | null;
+            /** Inhibit */
+            inhibit: boolean | null;
+            /**
+             * Inputs
+             * @description 0x60FD
+             */
+            inputs: number | null;
+            /** Negative Limit */
+            negative_limit: boolean | null;
+            /**
+             * Outputs
+             * @description 0x60FE,1
+             */
+            outputs: number | null;
+            /** Positive Limit */
+            positive_limit: boolean | null;
         };
         /** IssueModel */
         IssueModel: {
@@ -2936,6 +3557,11 @@ export interface components {
         };
         /** KeptRevisionModel */
         KeptRevisionModel: {
+            /**
+             * By
+             * @description who made the change that replaced it (empty when not recorded)
+             */
+            by: string;
             /** Files */
             files: number;
             /**
@@ -3944,6 +4570,132 @@ export interface components {
             /** Trigger */
             trigger: string;
         };
+        /**
+         * SavedFrequencyMarkers
+         * @description What the Bode page marks; null when the response has none (services/frequency/markers.py).
+         */
+        SavedFrequencyMarkers: {
+            /** Antiresonance Hz */
+            antiresonance_hz?: number | null;
+            /** Bandwidth Hz */
+            bandwidth_hz?: number | null;
+            /** Gain Margin Db */
+            gain_margin_db?: number | null;
+            /** Phase Margin Deg */
+            phase_margin_deg?: number | null;
+            /** Resonance Hz */
+            resonance_hz?: number | null;
+        } & {
+            [key: string]: unknown;
+        };
+        /**
+         * SavedFrequencyPoint
+         * @description One row of the pinned CSV; a value that is not a finite number there (``nan``: coherence not estimated) is
+         *     null here, JSON having no NaN.
+         */
+        SavedFrequencyPoint: {
+            /**
+             * Coherence
+             * @description 0..1
+             */
+            coherence: number | null;
+            /** Freq Hz */
+            freq_hz: number | null;
+            /**
+             * Magnitude Db
+             * @description plant: dB of (rad/s)/(N·m); closed loop: dB of actual/demanded
+             */
+            magnitude_db: number | null;
+            /** Phase Deg */
+            phase_deg: number | null;
+        };
+        /**
+         * SavedFrequencyResult
+         * @description A saved result with its points, as the measurement made it.
+         */
+        SavedFrequencyResult: {
+            /** Aborted */
+            aborted?: string | null;
+            /** Axis */
+            axis?: string | null;
+            /** Device */
+            device?: string | null;
+            /** Excitation */
+            excitation?: {
+                [key: string]: unknown;
+            } | null;
+            /**
+             * Gains
+             * @description the speed loop at measurement time (GET …/speed-loop)
+             */
+            gains?: {
+                [key: string]: unknown;
+            } | null;
+            /**
+             * Kind
+             * @default frequency_response
+             */
+            kind: string;
+            /** Loop */
+            loop: string;
+            markers?: components["schemas"]["SavedFrequencyMarkers"] | null;
+            /** Name */
+            name: string;
+            /** Node */
+            node?: number | null;
+            /**
+             * Plant Fit
+             * @description rigid fit of a plant measurement: inertia_kgm2, viscous_friction_nms_per_rad
+             */
+            plant_fit?: {
+                [key: string]: number;
+            } | null;
+            /** Points */
+            points: components["schemas"]["SavedFrequencyPoint"][];
+            /** Time */
+            time?: string | null;
+            /** User */
+            user?: string | null;
+        } & {
+            [key: string]: unknown;
+        };
+        /**
+         * SavedFrequencySummary
+         * @description A saved result without its points (``error``: a sidecar that cannot be read, naming its file).
+         */
+        SavedFrequencySummary: {
+            /** Aborted */
+            aborted?: string | null;
+            /** Axis */
+            axis?: string | null;
+            /** Device */
+            device?: string | null;
+            /** Error */
+            error?: string | null;
+            /** Excitation */
+            excitation?: {
+                [key: string]: unknown;
+            } | null;
+            /** Kind */
+            kind?: string | null;
+            /**
+             * Loop
+             * @description plant | closed
+             */
+            loop?: string | null;
+            markers?: components["schemas"]["SavedFrequencyMarkers"] | null;
+            /** Name */
+            name: string;
+            /** Node */
+            node?: number | null;
+            /**
+             * Time
+             * @description when it was measured, ISO-8601 UTC
+             */
+            time?: string | null;
+            /** User */
+            user?: string | null;
+        };
         /** ScanRequest */
         ScanRequest: {
             /**
@@ -4294,6 +5046,12 @@ export interface components {
                 [key: string]: number;
             };
             /**
+             * Speed Filter Choices S
+             * @description the speed-filter time constants a PUT takes (empty: the filter is fixed)
+             * @default []
+             */
+            speed_filter_choices_s: number[];
+            /**
              * Speed Filter S
              * @description time constant of the speed-measurement filter
              */
@@ -4519,6 +5277,21 @@ export interface components {
              * @example local
              */
             name: string;
+        };
+        /** ValueChangeModel */
+        ValueChangeModel: {
+            /** Index */
+            index: number;
+            /** Name */
+            name: string;
+            /** New */
+            new: number | string | null;
+            /** Old */
+            old: number | string | null;
+            /** Subindex */
+            subindex: number;
+            /** Unit */
+            unit: string;
         };
         /** WriteRequest */
         WriteRequest: {
@@ -5824,6 +6597,574 @@ export interface operations {
             };
             /** @description `too_large`: an upload larger than its limit; nothing was kept */
             413: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `invalid_input`: refused before anything was sent or written */
+            422: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `internal`: a bug: logged with the request id */
+            500: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `communication`: the drive or the link failed part-way (incomplete backup or restore) */
+            502: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `unavailable`: the bus is not connected, or an axis's drive cannot be reached */
+            503: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `timeout`: the drive did not answer in time */
+            504: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+        };
+    };
+    start_frequency_response_api_buses__bus__nodes__node__frequency_response_post: {
+        parameters: {
+            query?: {
+                /** @description device key (xtrapulspac, cd1k, …) overriding the identified one; by default the node is identified on first use */
+                device?: string | null;
+            };
+            header?: {
+                /** @description id announced by /api/ws/events; required for motion */
+                "X-Servo-Client"?: string | null;
+            };
+            path: {
+                bus: string;
+                node: number;
+            };
+            cookie?: never;
+        };
+        requestBody: {
+            content: {
+                "application/json": components["schemas"]["FrequencyStart"];
+            };
+        };
+        responses: {
+            /** @description Successful Response */
+            202: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["JobModel"];
+                };
+            };
+            /** @description `not_found`: unknown bus, node, job, object, device, project, axis or motor */
+            404: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `conflict`: the current state refuses it: a changed project, a taken name, the drive; `refused_for_safety`: refused to keep the machine safe (no live client, drive enabled); `refused_for_safety`: refused to keep the machine safe (no live client, drive enabled) */
+            409: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `invalid_input`: refused before anything was sent or written */
+            422: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `internal`: a bug: logged with the request id */
+            500: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `communication`: the drive or the link failed part-way (incomplete backup or restore) */
+            502: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `unavailable`: the bus is not connected, or an axis's drive cannot be reached */
+            503: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `timeout`: the drive did not answer in time */
+            504: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+        };
+    };
+    start_identification_api_buses__bus__nodes__node__identification_post: {
+        parameters: {
+            query?: {
+                /** @description device key (xtrapulspac, cd1k, …) overriding the identified one; by default the node is identified on first use */
+                device?: string | null;
+            };
+            header?: {
+                /** @description id announced by /api/ws/events; required for motion */
+                "X-Servo-Client"?: string | null;
+            };
+            path: {
+                bus: string;
+                node: number;
+            };
+            cookie?: never;
+        };
+        requestBody: {
+            content: {
+                "application/json": components["schemas"]["IdentificationStart"];
+            };
+        };
+        responses: {
+            /** @description Successful Response */
+            202: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["JobModel"];
+                };
+            };
+            /** @description `not_found`: unknown bus, node, job, object, device, project, axis or motor */
+            404: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `conflict`: the current state refuses it: a changed project, a taken name, the drive; `refused_for_safety`: refused to keep the machine safe (no live client, drive enabled) */
+            409: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `invalid_input`: refused before anything was sent or written */
+            422: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `internal`: a bug: logged with the request id */
+            500: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `communication`: the drive or the link failed part-way (incomplete backup or restore) */
+            502: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `unavailable`: the bus is not connected, or an axis's drive cannot be reached */
+            503: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `timeout`: the drive did not answer in time */
+            504: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+        };
+    };
+    read_api_buses__bus__nodes__node__io_get: {
+        parameters: {
+            query?: {
+                /** @description device key (xtrapulspac, cd1k, …) overriding the identified one; by default the node is identified on first use */
+                device?: string | null;
+            };
+            header?: {
+                /** @description id announced by /api/ws/events; required for motion */
+                "X-Servo-Client"?: string | null;
+            };
+            path: {
+                bus: string;
+                node: number;
+            };
+            cookie?: never;
+        };
+        requestBody?: never;
+        responses: {
+            /** @description Successful Response */
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["IoModel"];
+                };
+            };
+            /** @description `not_found`: unknown bus, node, job, object, device, project, axis or motor */
+            404: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `conflict`: the current state refuses it: a changed project, a taken name, the drive; `refused_for_safety`: refused to keep the machine safe (no live client, drive enabled) */
+            409: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `invalid_input`: refused before anything was sent or written */
+            422: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `internal`: a bug: logged with the request id */
+            500: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `communication`: the drive or the link failed part-way (incomplete backup or restore) */
+            502: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `unavailable`: the bus is not connected, or an axis's drive cannot be reached */
+            503: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `timeout`: the drive did not answer in time */
+            504: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+        };
+    };
+    change_api_buses__bus__nodes__node__io_put: {
+        parameters: {
+            query?: {
+                /** @description device key (xtrapulspac, cd1k, …) overriding the identified one; by default the node is identified on first use */
+                device?: string | null;
+            };
+            header?: {
+                /** @description id announced by /api/ws/events; required for motion */
+                "X-Servo-Client"?: string | null;
+            };
+            path: {
+                bus: string;
+                node: number;
+            };
+            cookie?: never;
+        };
+        requestBody: {
+            content: {
+                "application/json": components["schemas"]["IoChangeRequest"];
+            };
+        };
+        responses: {
+            /** @description Successful Response */
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["IoModel"];
+                };
+            };
+            /** @description `not_found`: unknown bus, node, job, object, device, project, axis or motor */
+            404: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `conflict`: the current state refuses it: a changed project, a taken name, the drive; `refused_for_safety`: refused to keep the machine safe (no live client, drive enabled) */
+            409: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `invalid_input`: refused before anything was sent or written */
+            422: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `internal`: a bug: logged with the request id */
+            500: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `communication`: the drive or the link failed part-way (incomplete backup or restore) */
+            502: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `unavailable`: the bus is not connected, or an axis's drive cannot be reached */
+            503: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `timeout`: the drive did not answer in time */
+            504: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+        };
+    };
+    sim_inputs_api_buses__bus__nodes__node__io_sim_inputs_put: {
+        parameters: {
+            query?: {
+                /** @description device key (xtrapulspac, cd1k, …) overriding the identified one; by default the node is identified on first use */
+                device?: string | null;
+            };
+            header?: {
+                /** @description id announced by /api/ws/events; required for motion */
+                "X-Servo-Client"?: string | null;
+            };
+            path: {
+                bus: string;
+                node: number;
+            };
+            cookie?: never;
+        };
+        requestBody: {
+            content: {
+                "application/json": components["schemas"]["IoSimInputsRequest"];
+            };
+        };
+        responses: {
+            /** @description Successful Response */
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["IoLiveModel"];
+                };
+            };
+            /** @description `not_found`: unknown bus, node, job, object, device, project, axis or motor */
+            404: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `conflict`: the current state refuses it: a changed project, a taken name, the drive; `refused_for_safety`: refused to keep the machine safe (no live client, drive enabled) */
+            409: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `invalid_input`: refused before anything was sent or written */
+            422: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `internal`: a bug: logged with the request id */
+            500: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `communication`: the drive or the link failed part-way (incomplete backup or restore) */
+            502: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `unavailable`: the bus is not connected, or an axis's drive cannot be reached */
+            503: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `timeout`: the drive did not answer in time */
+            504: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+        };
+    };
+    live_api_buses__bus__nodes__node__io_state_get: {
+        parameters: {
+            query?: {
+                /** @description device key (xtrapulspac, cd1k, …) overriding the identified one; by default the node is identified on first use */
+                device?: string | null;
+            };
+            header?: {
+                /** @description id announced by /api/ws/events; required for motion */
+                "X-Servo-Client"?: string | null;
+            };
+            path: {
+                bus: string;
+                node: number;
+            };
+            cookie?: never;
+        };
+        requestBody?: never;
+        responses: {
+            /** @description Successful Response */
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["IoLiveModel"];
+                };
+            };
+            /** @description `not_found`: unknown bus, node, job, object, device, project, axis or motor */
+            404: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `conflict`: the current state refuses it: a changed project, a taken name, the drive; `refused_for_safety`: refused to keep the machine safe (no live client, drive enabled) */
+            409: {
                 headers: {
                     [name: string]: unknown;
                 };
@@ -8046,6 +9387,15 @@ export interface operations {
             };
             /** @description `conflict`: the current state refuses it: a changed project, a taken name, the drive; `refused_for_safety`: refused to keep the machine safe (no live client, drive enabled) */
             409: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `too_large`: an upload larger than its limit; nothing was kept */
+            413: {
                 headers: {
                     [name: string]: unknown;
                 };
@@ -11300,6 +12650,85 @@ export interface operations {
             };
         };
     };
+    import_dcf_api_projects__name__axes__axis__dcf_post: {
+        parameters: {
+            query?: {
+                revision?: string | null;
+                /** @description check and answer what would change, write nothing */
+                dry_run?: boolean;
+            };
+            header?: {
+                /** @description id announced by /api/ws/events; required for motion */
+                "X-Servo-Client"?: string | null;
+            };
+            path: {
+                name: string;
+                axis: string;
+            };
+            cookie?: never;
+        };
+        requestBody: {
+            content: {
+                "multipart/form-data": components["schemas"]["Body_import_dcf_api_projects__name__axes__axis__dcf_post"];
+            };
+        };
+        responses: {
+            /** @description Successful Response */
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["DcfImportModel"];
+                };
+            };
+            /** @description `not_found`: unknown bus, node, job, object, device, project, axis or motor */
+            404: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `conflict`: the current state refuses it: a changed project, a taken name, the drive */
+            409: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `too_large`: an upload larger than its limit; nothing was kept */
+            413: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `invalid_input`: refused before anything was sent or written */
+            422: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `internal`: a bug: logged with the request id */
+            500: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+        };
+    };
     select_motor_api_projects__name__axes__axis__motor_post: {
         parameters: {
             query?: never;
@@ -11783,6 +13212,15 @@ export interface operations {
             };
             /** @description `conflict`: the current state refuses it: a changed project, a taken name, the drive; `refused_for_safety`: refused to keep the machine safe (no live client, drive enabled) */
             409: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `too_large`: an upload larger than its limit; nothing was kept */
+            413: {
                 headers: {
                     [name: string]: unknown;
                 };
@@ -12842,6 +14280,276 @@ export interface operations {
             };
         };
     };
+    list_saved_api_projects__project__axes__axis__frequency_get: {
+        parameters: {
+            query?: never;
+            header?: {
+                /** @description id announced by /api/ws/events; required for motion */
+                "X-Servo-Client"?: string | null;
+            };
+            path: {
+                project: string;
+                axis: string;
+            };
+            cookie?: never;
+        };
+        requestBody?: never;
+        responses: {
+            /** @description Successful Response */
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["SavedFrequencySummary"][];
+                };
+            };
+            /** @description `not_found`: unknown bus, node, job, object, device, project, axis or motor */
+            404: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `invalid_input`: refused before anything was sent or written */
+            422: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `internal`: a bug: logged with the request id */
+            500: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+        };
+    };
+    open_saved_api_projects__project__axes__axis__frequency__name__get: {
+        parameters: {
+            query?: never;
+            header?: {
+                /** @description id announced by /api/ws/events; required for motion */
+                "X-Servo-Client"?: string | null;
+            };
+            path: {
+                project: string;
+                axis: string;
+                name: string;
+            };
+            cookie?: never;
+        };
+        requestBody?: never;
+        responses: {
+            /** @description Successful Response */
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["SavedFrequencyResult"];
+                };
+            };
+            /** @description `not_found`: unknown bus, node, job, object, device, project, axis or motor */
+            404: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `invalid_input`: refused before anything was sent or written */
+            422: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `internal`: a bug: logged with the request id */
+            500: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+        };
+    };
+    delete_saved_api_projects__project__axes__axis__frequency__name__delete: {
+        parameters: {
+            query?: never;
+            header?: {
+                /** @description id announced by /api/ws/events; required for motion */
+                "X-Servo-Client"?: string | null;
+            };
+            path: {
+                project: string;
+                axis: string;
+                name: string;
+            };
+            cookie?: never;
+        };
+        requestBody?: never;
+        responses: {
+            /** @description Successful Response */
+            204: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content?: never;
+            };
+            /** @description `not_found`: unknown bus, node, job, object, device, project, axis or motor */
+            404: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `invalid_input`: refused before anything was sent or written */
+            422: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `internal`: a bug: logged with the request id */
+            500: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+        };
+    };
+    saved_csv_api_projects__project__axes__axis__frequency__name__csv_get: {
+        parameters: {
+            query?: never;
+            header?: {
+                /** @description id announced by /api/ws/events; required for motion */
+                "X-Servo-Client"?: string | null;
+            };
+            path: {
+                project: string;
+                axis: string;
+                name: string;
+            };
+            cookie?: never;
+        };
+        requestBody?: never;
+        responses: {
+            /** @description Successful Response */
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "text/csv": unknown;
+                };
+            };
+            /** @description `not_found`: unknown bus, node, job, object, device, project, axis or motor */
+            404: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `invalid_input`: refused before anything was sent or written */
+            422: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `internal`: a bug: logged with the request id */
+            500: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+        };
+    };
+    saved_html_api_projects__project__axes__axis__frequency__name__html_get: {
+        parameters: {
+            query?: {
+                /** @description saved results to overlay */
+                compare?: string[];
+            };
+            header?: {
+                /** @description id announced by /api/ws/events; required for motion */
+                "X-Servo-Client"?: string | null;
+            };
+            path: {
+                project: string;
+                axis: string;
+                name: string;
+            };
+            cookie?: never;
+        };
+        requestBody?: never;
+        responses: {
+            /** @description Successful Response */
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "text/html": unknown;
+                };
+            };
+            /** @description `not_found`: unknown bus, node, job, object, device, project, axis or motor */
+            404: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `invalid_input`: refused before anything was sent or written */
+            422: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `internal`: a bug: logged with the request id */
+            500: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+        };
+    };
     list_saved_api_projects__project__axes__axis__procedures_get: {
         parameters: {
             query?: never;
@@ -12866,6 +14574,61 @@ export interface operations {
                     "application/json": {
                         [key: string]: unknown;
                     }[];
+                };
+            };
+            /** @description `not_found`: unknown bus, node, job, object, device, project, axis or motor */
+            404: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `invalid_input`: refused before anything was sent or written */
+            422: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `internal`: a bug: logged with the request id */
+            500: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+        };
+    };
+    get_report_api_projects__project__report_get: {
+        parameters: {
+            query?: {
+                /** @description one axis of the project (default: every axis) */
+                axis?: string | null;
+            };
+            header?: {
+                /** @description id announced by /api/ws/events; required for motion */
+                "X-Servo-Client"?: string | null;
+            };
+            path: {
+                project: string;
+            };
+            cookie?: never;
+        };
+        requestBody?: never;
+        responses: {
+            /** @description Successful Response */
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "text/html": unknown;
                 };
             };
             /** @description `not_found`: unknown bus, node, job, object, device, project, axis or motor */

@@ -19,6 +19,8 @@ export type RecorderStatus = Schemas["RecorderStatus"];
 export type SavedCapture = Schemas["SavedCaptureModel"];
 export type Preset = Schemas["PresetModel"];
 export type ExportKind = "csv" | "html";
+export type RollRequest = Schemas["RollRequest"];
+export type RollStarted = Schemas["RollModel"];
 
 /** What a capture job's result holds (`services/scope/service.py`). */
 export interface CaptureJobResult {
@@ -51,7 +53,15 @@ export const scopeApi = {
   capture: (bus: string, node: number, id: string) =>
     whenMapped(() => get<CaptureData>(`${nodePath(bus, node)}/captures/${e(id)}`)),
   exportUrl: (bus: string, node: number, id: string, kind: ExportKind) => `${nodePath(bus, node)}/captures/${e(id)}/${kind}`,
+  /** Live roll mode: the server checks the bus budget (422 with the reason), then streams on `socket`. */
+  roll: (bus: string, node: number, request: RollRequest) => whenMapped(() => post<RollStarted>(`${nodePath(bus, node)}/roll`, request)),
 };
+
+/** The roll's WebSocket (the answer's `socket` path) on this page's server. */
+export function rollSocket(path: string): WebSocket {
+  const protocol = window.location.protocol === "https:" ? "wss:" : "ws:";
+  return new WebSocket(`${protocol}//${window.location.host}${path}`);
+}
 
 export const savedCaptures = {
   list: (project: string, axis: string) => get<SavedCapture[]>(axisPath(project, axis)),

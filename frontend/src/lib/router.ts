@@ -3,7 +3,7 @@
  * with index.html, and this module turns the path back into the page to show.
  */
 
-export const AXIS_VIEWS = ["dashboard", "parameters", "commissioning", "backup", "scope", "current-loop", "phasing", "tuning", "sequences"] as const;
+export const AXIS_VIEWS = ["dashboard", "parameters", "commissioning", "backup", "scope", "current-loop", "phasing", "tuning", "bode", "sequences", "io"] as const;
 export type AxisView = (typeof AXIS_VIEWS)[number];
 
 export type Route =

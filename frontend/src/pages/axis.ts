@@ -6,12 +6,14 @@ import { h, Scope } from "../lib/dom";
 import { forNode, type Dictionary } from "../lib/od";
 import { buildPath, type AxisView } from "../lib/router";
 import { axisStateText } from "../client/live";
+import { reportButton } from "../components/report/button";
 import { backupView } from "./backup";
 import { commissioningView } from "./commissioning";
 import { dashboardView } from "./dashboard";
 import { parametersView } from "./axisparams";
 import { currentLoopView } from "./currentloop";
 import { phasingView } from "./phasing";
+import { ioView } from "./io";
 import { sequencesView } from "./sequences";
 
 export interface AxisContext {
@@ -39,7 +41,9 @@ const VIEWS: [AxisView, string, string][] = [
   ["current-loop", "Current loop", ""],
   ["phasing", "Phasing", ""],
   ["tuning", "Auto-tuning", ""],
+  ["bode", "Bode / what-if", ""],
   ["sequences", "Sequences", ""],
+  ["io", "I/O", ""],
 ];
 
 export async function axisPage(context: PageContext, projectName: string, axisName: string, view: AxisView): Promise<Page> {
@@ -62,8 +66,10 @@ export async function axisPage(context: PageContext, projectName: string, axisNa
           : view === "current-loop" ? currentLoopView(axisContext)
             : view === "phasing" ? phasingView(axisContext)
               : view === "tuning" ? import("./tuning").then((module) => module.tuningView(axisContext)) // plots with plotly
+                : view === "bode" ? import("./bode").then((module) => module.bodeView(axisContext)) // plotly only here
                 : view === "sequences" ? sequencesView(axisContext)
-                  : backupView(axisContext));
+                  : view === "io" ? ioView(axisContext)
+                    : backupView(axisContext));
 
   // The header follows the live hub, which outlives the page: its binding is stopped with the page's scope.
   const scope = new Scope();
@@ -79,7 +85,7 @@ export async function axisPage(context: PageContext, projectName: string, axisNa
   const head = h("div", { class: "page-head" },
     h("h1", { "data-testid": "axis-title" }, axis.name),
     h("span", { class: "muted" }, `${dictionary.product_name} · node ${axis.node_id} · bus ${axis.bus}${axis.motor ? ` · motor ${axis.motor}` : ""}`),
-    state);
+    state, reportButton(project.name, axis.name));
   const wrapper = h("div", { class: "page", style: { paddingBottom: "0", flex: "none" } }, head, tabs);
   viewPage.element.style.flex = "1";
   return {

@@ -124,7 +124,8 @@ function stepLink(view: ChecklistView, step: Step): Node {
     case "current-loop":
     case "phasing":
     case "tuning":
-      return h("span", { class: "toolbar" }, page(step.page, PROCEDURE_PAGES[step.page]), parameters);
+      return h("span", { class: "toolbar" }, page(step.page, PROCEDURE_PAGES[step.page]),
+        step.page === "tuning" ? page("bode", "Bode / what-if") : null, parameters);
     default:
       return parameters ?? h("span", { class: "muted" }, "—");
   }

@@ -19,7 +19,9 @@ import { statusWordPanel } from "../components/dashboard/status-word";
 import { heldByMe } from "../client/control";
 import { dashboardSignals } from "../lib/dashboard-objects";
 import { buildPath } from "../lib/router";
-import { Scope, h } from "../lib/dom";
+import { ioApi } from "../client/io";
+import { Scope, h, state } from "../lib/dom";
+import { ioNames, type IoNames } from "../lib/io-names";
 import type { Entry } from "../lib/od";
 import { formatValue } from "../lib/values";
 import type { AxisContext, AxisViewPage } from "./axis";
@@ -61,7 +63,17 @@ function layout(model: DashboardModel, context: AxisContext, motion: QuickMotion
         entry: model.signals.statusword, statusword: model.statusword,
         address: model.signals.statusword ? model.key(model.signals.statusword) : "",
       }),
-      digitalIo({ inputs: model.signals.inputs, outputs: model.signals.outputs, word: (entry) => liveWord(model, entry), address: (entry) => model.key(entry) })));
+      digitalIo({
+        inputs: model.signals.inputs, outputs: model.signals.outputs, word: (entry) => liveWord(model, entry), address: (entry) => model.key(entry),
+        names: ioNamesOf(context),
+      })));
+}
+
+/** The names the axis's I/O configuration gives its inputs and outputs (docs/io.md), once read; none on failure. */
+function ioNamesOf(context: AxisContext): () => IoNames | null {
+  const names = state<IoNames | null>(null);
+  void ioApi.read(context.axis.bus, context.axis.node_id).then((config) => (names.val = ioNames(config))).catch(() => undefined);
+  return () => names.val;
 }
 
 function control(model: DashboardModel): HTMLElement {

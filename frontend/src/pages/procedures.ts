@@ -31,7 +31,8 @@ export async function procedureView(context: AxisContext, main: (view: Procedure
   return { element, dispose: () => scope.dispose() };
 }
 
-function controller(view: ProcedureView): HTMLElement {
+/** The axis's Controller panel (also on the Bode page, whose measurement turns the motor). */
+export function controller(view: ProcedureView): HTMLElement {
   const { model, context } = view;
   return controllerPanel({
     control: model.holder, askedBy: model.askedBy, busy: model.busy,
@@ -48,6 +49,7 @@ const ORDER: [AxisView, string, string][] = [
   ["current-loop", "1. Current loop", "inductance and drive current → 'calc'; current limits and I²t (Fusing while commissioning)"],
   ["phasing", "2. Phasing", "auto-phasing ('apha') after 'calc'; motor phasing ('mcal') at each power-up of an encoder without Hall sensors"],
   ["tuning", "3. Auto-tuning", "identify inertia and friction, compute the gains ('atun'), verify with a step"],
+  ["bode", "4. Bode / what-if", "measure the plant and the closed loop, try gains on the measured plant before writing them"],
 ];
 
 /** The manual's order: auto-phasing on an uncommissioned drive fails before the current loop is calculated. */

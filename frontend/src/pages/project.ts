@@ -1,14 +1,17 @@
-/** One project: its buses and axes (add, edit, remove), archive download, DCF export, commission, compare. */
+/** One project: its buses and axes (add, edit, remove), archive download, DCF export and import, commission, compare, kept revisions. */
 
 import type { App, Page, PageContext } from "../app";
-import { listDictionaries, projects, type AxisConfig, type BusConfig, type Project } from "../client/api";
+import { listDictionaries, projectAddress, projects, type AxisConfig, type BusConfig, type DcfImport, type Project } from "../client/api";
 import { busMatches, driveApi, serverBus, type BusInfo, type BusMatch } from "../client/drives";
 import { axisStateText } from "../client/live";
 import { commissionPanel } from "../components/commissionjob";
+import { confirmChanges } from "../components/confirm/changes";
 import { axisDialog, busesDialog, renameDialog } from "../components/project-dialogs";
-import { confirmAction, download, failure, messageView, toast, type Message } from "../components/ui";
+import { revisionsPanel } from "../components/project-revisions";
+import { reportButton } from "../components/report/button";
+import { confirmAction, download, failure, messageView, pickFile, toast, type Message } from "../components/ui";
 import { h, Scope, state, type State } from "../lib/dom";
-import type { DictionarySummary } from "../lib/od";
+import type { DictionarySummary, Scalar } from "../lib/od";
 import { buildPath } from "../lib/router";
 
 /** What the parts of the page share: the project as the server last answered it, and the server's buses. */
@@ -18,12 +21,21 @@ interface ProjectView {
   devices: DictionarySummary[];
   serverBuses: State<BusInfo[]>;
   message: State<Message | null>;
+  dcfImport: State<DcfResult | null>;
+}
+
+/** The last DCF import: which axis, from which file, and what it set and left out. */
+interface DcfResult {
+  axis: string;
+  file: string;
+  result: DcfImport;
 }
 
 export async function projectPage(context: PageContext, name: string): Promise<Page> {
   const { app } = context;
   const [project, devices, buses] = await Promise.all([projects.get(name), listDictionaries(), driveApi.buses().catch(() => [])]);
-  const view: ProjectView = { app, project: state(project), devices, serverBuses: state(buses), message: state<Message | null>(null) };
+  const view: ProjectView = { app, project: state(project), devices, serverBuses: state(buses), message: state<Message | null>(null),
+    dcfImport: state<DcfResult | null>(null) };
   // Rows follow the live hub and the bus mapping, which outlive the page: the page's scope stops those bindings.
   const scope = new Scope();
   return {
@@ -35,9 +47,11 @@ export async function projectPage(context: PageContext, name: string): Promise<P
         h("span", { class: "muted" }, () => view.project.val.description)),
       projectToolbar(view),
       messageView(view.message),
+      dcfImportResult(view),
       h("div", { class: "panel" }, h("h2", null, "Axes"), axesTable(view)),
       commissionPanel(app, project.name, () => void projects.get(project.name).then((next) => changed(view, next))),
-      h("div", { class: "panel" }, h("h2", null, "Buses"), busesTable(view)))),
+      h("div", { class: "panel" }, h("h2", null, "Buses"), busesTable(view)),
+      revisionsPanel(view.project, (next) => changed(view, next)))),
   };
 }
 
@@ -67,6 +81,7 @@ function projectToolbar(view: ProjectView): HTMLElement {
     h("a", { class: "button", href: buildPath({ page: "compare", project: project().name }) }, "Compare"),
     h("button", { onclick: () => busesDialog(project(), onChange) }, "Buses…"),
     h("button", { "data-testid": "archive", onclick: () => download(projects.archiveUrl(project().name)), title: "Download the project as one .zip file" }, "Archive"),
+    reportButton(project().name),
     h("button", { onclick: () => renameDialog(app, project(), false) }, "Rename…"),
     h("button", { onclick: () => renameDialog(app, project(), true) }, "Duplicate…"),
     h("button", { class: "danger", onclick: () => void deleteProject(view) }, "Delete…"));
@@ -111,8 +126,55 @@ function axisRow(view: ProjectView, project: Project, axis: AxisConfig): HTMLEle
     h("td", { class: "wrap" }, axis.description),
     h("td", null, h("span", { class: "toolbar" }, link("parameters", "Parameters"), link("commissioning", "Checklist"),
       h("button", { class: "small", onclick: () => download(projects.dcfUrl(project.name, axis.name)), title: "Export the project values as a CiA 306 DCF" }, "DCF"),
+      h("button", { class: "small", "data-testid": `import-dcf-${axis.name}`, onclick: () => void importDcf(view, axis), title: "Set the axis's project values to what a CiA 306 DCF configures" }, "Import DCF…"),
       h("button", { class: "small", onclick: () => axisDialog(project, view.devices, axis, (next) => changed(view, next)) }, "Edit"),
       h("button", { class: "small danger", onclick: () => void removeAxis(view, axis) }, "Remove"))));
+}
+
+/** Pick a DCF and set the axis's project values to what it configures: the server checks it all first (a dry
+ * run), the user confirms the list of changes (old → new), then it is imported at the revision that was shown. */
+async function importDcf(view: ProjectView, axis: AxisConfig): Promise<void> {
+  const file = await pickFile(".dcf,.DCF,.eds,.EDS");
+  if (!file) return;
+  await guard(view, async () => {
+    view.dcfImport.val = null;
+    const project = view.project.rawVal;
+    const preview = await projects.importDcf(project.name, axis.name, file, project.revision, true);
+    if (!(await confirmDcfImport(axis, file, preview))) return;
+    const result = await projects.importDcf(project.name, axis.name, file, preview.revision);
+    view.dcfImport.val = { axis: axis.name, file: file.name, result };
+    changed(view, await projects.get(project.name));
+  });
+}
+
+function confirmDcfImport(axis: AxisConfig, file: File, preview: DcfImport): Promise<boolean> {
+  const value = (raw: Scalar, unit: string) => (raw === null ? "—" : `${raw} ${unit}`.trim());
+  const count = preview.changes.length;
+  return confirmChanges({
+    title: "Import DCF",
+    text: `${count} project value${count === 1 ? "" : "s"} of axis ${axis.name} change to what ${file.name} configures (project → DCF).`,
+    changes: preview.changes.map((change) => ({ address: projectAddress(change.index, change.subindex), name: change.name,
+      old: value(change.old, change.unit), new: value(change.new, change.unit) })),
+    notes: [
+      ...(preview.skipped.length ? [`${preview.skipped.length} configured value${preview.skipped.length === 1 ? "" : "s"} the project cannot hold will be left out (listed after the import).`] : []),
+      "The project as it is now is kept as a revision: you can restore it below.",
+    ],
+    confirm: "Import",
+    folded: count > 20,
+  });
+}
+
+/** What the last DCF import set, and every configured value it left out with its reason. */
+function dcfImportResult(view: ProjectView): HTMLElement {
+  return h("div", null, () => {
+    const last = view.dcfImport.val;
+    if (!last) return null;
+    const { parameters, skipped } = last.result;
+    const left = skipped.length ? ` ${skipped.length} configured value${skipped.length === 1 ? "" : "s"} left out:` : "";
+    return h("div", { class: `message ${skipped.length ? "warn" : "ok"}`, "data-testid": "dcf-result" },
+      `Axis ${last.axis}: ${parameters.length} project value${parameters.length === 1 ? "" : "s"} set from ${last.file}.${left}`,
+      skipped.length ? h("ul", { "data-testid": "dcf-skipped" }, skipped.map((reason) => h("li", null, reason))) : null);
+  });
 }
 
 async function removeAxis(view: ProjectView, axis: AxisConfig): Promise<void> {

@@ -1,7 +1,8 @@
 /**
  * The oscilloscope of one axis (tab "Scope"): the drive's recorder configured, armed, forced and stopped from the
  * page (keys a, f, s), the capture drawn with plotly.js (loaded on first use) with cursors, measurements, a math
- * trace and an FFT view, exported (CSV, HTML, PNG) and saved in the project under the axis.
+ * trace and an FFT view, exported (CSV, HTML, PNG) and saved in the project under the axis; below, live roll mode
+ * (the same channels streamed through TPDOs, `components/scope/roll.ts`).
  */
 
 import { serverBus } from "../client/drives";
@@ -11,6 +12,7 @@ import { arm, createModel, force, refreshSaved, stop } from "../components/scope
 import { recordableIndex } from "../components/scope/picker";
 import { plotView } from "../components/scope/plot";
 import { readoutView } from "../components/scope/readout";
+import { rollView } from "../components/scope/roll";
 import { keepView } from "../components/scope/saved";
 import { errorText } from "../components/ui";
 import { h, Scope } from "../lib/dom";
@@ -28,8 +30,9 @@ export async function scopeView(context: AxisContext): Promise<AxisViewPage> {
   const index = recordableIndex(dictionary);
   const scope = new Scope();
   const plot = plotView(model, scope);
+  const roll = rollView(model, scope);
   const element = scope.run(() => h("div", { class: "page grid", style: { gap: "10px", alignContent: "start" } },
-    controlsView(model, index), plot.element, readoutView(model), keepView(model, plot)));
+    controlsView(model, index), plot.element, readoutView(model), keepView(model, plot), roll.element));
   void load(model);
   return {
     element,
@@ -40,6 +43,7 @@ export async function scopeView(context: AxisContext): Promise<AxisViewPage> {
     },
     dispose: () => {
       plot.dispose();
+      roll.dispose();
       scope.dispose();
     },
   };

@@ -12,7 +12,9 @@ import { createModel, type SequenceModel } from "../components/sequences/model";
 import { onlinePanel } from "../components/sequences/online";
 import { sequenceTable } from "../components/sequences/table";
 import { download, errorText, messageView, pickFile } from "../components/ui";
+import { ioApi } from "../client/io";
 import { h, Scope } from "../lib/dom";
+import { ioNames } from "../lib/io-names";
 import type { AxisContext, AxisViewPage } from "./axis";
 
 export async function sequencesView(context: AxisContext): Promise<AxisViewPage> {
@@ -27,6 +29,7 @@ export async function sequencesView(context: AxisContext): Promise<AxisViewPage>
       h("div", { class: "grid", style: { gap: "10px", alignContent: "start" } },
         h("section", { class: "panel" }, h("h2", null, "Chaining graph"), h("div", { class: "panel-body" }, graphView(model))),
         onlinePanel(model, scope)))));
+  void ioApi.read(axis.bus, axis.node_id).then((config) => (model.ioNames.val = ioNames(config))).catch(() => undefined);
   try {
     await model.load();
   } catch (error) {

@@ -1,10 +1,12 @@
 /**
  * Auto-tuning of one axis (tab "Auto-tuning", manual §1.8.16 / §4.11): the options as the manual names them, the
  * safety checklist, start / abort / progress, and the result — the identified plant, the gains before → after with
- * their meaning, the verification step(s) plotted, Undo — and the results kept in the project.
+ * their meaning, the verification step(s) plotted, Undo — and the results kept in the project; beside it the tool's own
+ * identification, for a drive without auto-tuning (encoTRive) or as a cross-check (docs/identification.md).
  */
 
 import type { TuningOptions } from "../client/procedures";
+import { identificationPanel } from "../components/identification/panel";
 import { brakeRemedy } from "../components/procedures/brake";
 import type { ProceduresModel } from "../components/procedures/model";
 import { runnerPanel } from "../components/procedures/runner";
@@ -31,6 +33,7 @@ const MODES: Choice<"mode"> = [
 export function tuningView(context: AxisContext): Promise<AxisViewPage> {
   return procedureView(context, ({ model }) => [
     tuningPanel(model),
+    identificationPanel(model),
     savedPanel(model, ["auto_tuning"], "Auto-tuning results kept in the project"),
   ]);
 }

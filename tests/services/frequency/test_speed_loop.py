@@ -83,6 +83,8 @@ def test_a_gain_beyond_the_multiplier_rescales_every_scaled_gain(
         ({"speed_filter_s": 0.7e-3}, "one of 0.0005, 0.001, 0.002"),
         ({"kp_a_per_rad_s": 1.0, "current_filter_2_hz": 5000}, "1000"),
         ({"kd_a_per_rad_s2": 1.0}, "out of range"),
+        ({"ki_a_per_rad": 1.2e308}, "out of range even with the largest multiplier"),  # found by schemathesis
+        ({"kd_a_per_rad_s2": 1.7e308}, "out of range"),
     ],
 )
 def test_bad_values_are_refused_before_anything_is_written(

@@ -8,6 +8,7 @@ from datetime import UTC, datetime
 from pathlib import Path
 
 from servostudio.od import builtin_library
+from servostudio.services.audit import Actor, acting_as
 from servostudio.services.procedures.store import ResultStore
 from servostudio.services.projects import ProjectService
 
@@ -24,3 +25,13 @@ def test_results_are_listed_newest_first_and_leave_the_revision_alone(tmp_path):
     assert first.startswith("X/procedures/auto_tuning-") and second.startswith("X/procedures/auto_phasing-")
     assert [result["n"] for result in store.list("demo", "X")] == [2, 1]
     assert projects.store.open("demo").revision == before
+
+
+def test_a_result_records_who_ran_it(tmp_path):
+    """The commissioning report's "who": the user the procedure ran for, or the one a result already names."""
+    shutil.copytree(DEMO, tmp_path / "demo")
+    store = ResultStore(ProjectService(tmp_path, builtin_library()).store)
+    with acting_as(Actor("alice", "expert")):
+        store.save("demo", "X", "auto_tuning", {"status": "done"}, datetime(2026, 1, 1, tzinfo=UTC))
+        store.save("demo", "X", "auto_phasing", {"status": "done", "user": "bob"}, datetime(2026, 1, 2, tzinfo=UTC))
+    assert [result["user"] for result in store.list("demo", "X")] == ["bob", "alice"]

@@ -122,6 +122,22 @@ def test_the_cd1k_runs_its_own_auto_phasing(bench_factory):
     assert bench.machine().read("0x3410").raw == 5  # the CD1-k's own trigger
 
 
+def test_the_cd1k_runs_its_own_motor_phasing(bench_factory):
+    """The offset entered 40° electrical off (the pole pairs and phase order right): the CD1-k's 'mcal' finds it
+    again, through the CD1-k profile's objects (commutation in 0x6410,2..4, trigger 0x3414)."""
+    bench = bench_factory(nodes="1:cd1k")
+    plant = bench.plant()
+    machine = bench.machine()
+    for key, value in (("0x6510,5", 0x3FFF), ("0x6510,6", 0x1FFF), ("0x6410,2", plant.pole_pairs)):
+        machine.write(key, value)
+    machine.write("0x6410,4", (plant.sensor_offset + 65536 * 40 // 360) % 65536)
+    result = bench.run("motor_phasing")
+    assert result["status"] == "done" and machine.read("0x3414").raw == 5
+    error = (int(result["sensor_offset"]) - plant.sensor_offset) % 65536
+    assert min(error, 65536 - error) <= 65536 * 2 / 360
+    assert result["before"]["sensor_offset"] == (plant.sensor_offset + 65536 * 40 // 360) % 65536
+
+
 def test_the_cd1k_plant_is_reported_per_ampere_never_as_physical_units_it_cannot_know(bench_factory):
     """The CD1-k has no torque-constant object: its drive identifies J/Kt, B/Kt, …; the tool must not label those
     kg·m² and N·m·s/rad."""

@@ -7,7 +7,7 @@ import math
 
 import pytest
 
-from servostudio.services.procedures.stepmetrics import step_metrics
+from servostudio.services.procedures.stepmetrics import mean_bandwidth, step_metrics, window
 
 DT = 250e-6
 
@@ -39,3 +39,19 @@ def test_a_second_order_loop_overshoots_as_its_damping_says():
     times, reference, response = _simulate(1600, lambda s, r: [s[1], wn * wn * (r - s[0]) - 2 * zeta * wn * s[1], s[1]])
     expected = 100 * math.exp(-zeta * math.pi / math.sqrt(1 - zeta * zeta))
     assert step_metrics(times, reference, response).overshoot_pct == pytest.approx(expected, abs=1.0)
+
+
+def test_the_mean_response_of_a_rising_and_a_falling_step_of_one_loop():
+    """Two steps of an 80 Hz loop, one up and one down, each with its own quantisation of the measured output (as
+    the drive's speed is quantised): the bandwidth of their mean response is the loop's."""
+    loop = 2 * math.pi * 80
+
+    def recorded(height: float, offset: float):
+        times, reference, response = _simulate(1200, lambda s, r: [loop * (r - s[0]), 0.0, loop * 10 * (s[0] - s[2])])
+        quantised = [round((value * height / 100 + offset) / 0.7) * 0.7 for value in response]
+        return window(times, [value * height / 100 + offset for value in reference], quantised)
+
+    up, down = recorded(100.0, 0.0), recorded(-100.0, 20.0)
+    assert up is not None and down is not None
+    assert mean_bandwidth([up, down]) == pytest.approx(80.0, rel=0.05)
+    assert mean_bandwidth([]) is None

@@ -40,7 +40,7 @@ def test_a_dcfs_configured_values_become_the_axis_values(axes: ProjectService, t
     shown = load_dictionary(dcf)
     assert (shown[0x1400, 2].default, shown[0x1400, 2].parameter_value) == (255, 1)  # shown as configured
 
-    imported = axes.import_dcf("p", "Y", dcf)
+    imported = axes.import_dcf("p", "Y", dcf.read_text(encoding="latin-1"), dcf.name)
     assert {(row.variable.index, row.variable.subindex): row.value for row in imported.change.rows} == {
         (0x1400, 1): 0x304,  # $NODEID resolved for the axis (node 4)
         (0x1400, 2): 1,
@@ -55,7 +55,7 @@ def test_export_then_import_gives_the_same_values(axes: ProjectService, tmp_path
     axes.parameters.set("p", "X", {"0x6060": -3, "0x3050,1": 0x60FD0003, "0x2004": "Lift axis", "0x1006": 20000})
     dcf = tmp_path / "X.dcf"
     dcf.write_text(axes.dcf("p", "X"), encoding="latin-1", newline="")
-    imported = axes.import_dcf("p", "Y", dcf)
+    imported = axes.import_dcf("p", "Y", dcf.read_text(encoding="latin-1"), dcf.name)
     assert imported.skipped == []
     for address, value in (("0x6060", -3), ("0x3050,1", 0x60FD0003), ("0x2004", "Lift axis"), ("0x1006", 20000)):
         assert _row(axes, "Y", address).value == value, address
@@ -65,13 +65,14 @@ def test_an_out_of_range_configured_value_changes_nothing(axes: ProjectService, 
     text = (EDS / "xtrapulspac.eds").read_text(encoding="latin-1")
     dcf = tmp_path / "bad.dcf"
     dcf.write_text(_configure(_configure(text, "1400sub2", "1"), "3410sub1", "25"), encoding="latin-1")
-    with pytest.raises(DictionaryError, match="ParameterValue 25 is outside the limits"):
-        axes.import_dcf("p", "Y", dcf)
+    with pytest.raises(DictionaryError, match="ParameterValue 25 is outside the limits") as refused:
+        axes.import_dcf("p", "Y", dcf.read_text(encoding="latin-1"), dcf.name)
     assert _row(axes, "Y", "0x1400,2").file is None
+    assert str(refused.value).startswith("bad.dcf:") and str(tmp_path) not in str(refused.value)  # no server path
 
 
 def test_a_dcf_of_another_device_is_refused(axes: ProjectService, tmp_path: Path) -> None:
     dcf = tmp_path / "cd1k.dcf"
     dcf.write_text(_configure((EDS / "cd1k.eds").read_text(encoding="latin-1"), "6060", "1"), encoding="latin-1")
     with pytest.raises(ParameterRefused, match="the axis is a xtrapulspac"):
-        axes.import_dcf("p", "Y", dcf)
+        axes.import_dcf("p", "Y", dcf.read_text(encoding="latin-1"), dcf.name)

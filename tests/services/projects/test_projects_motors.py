@@ -85,6 +85,15 @@ def test_malformed_motor_file_names_file_and_line():
     assert (caught.value.line, caught.value.reason) == (5, "motor data 'pole_pairs' must be an integer")
 
 
+def test_a_malformed_catalog_file_is_named_by_its_place_in_the_catalog(tmp_path: Path):
+    user = tmp_path / "store" / ".motors"
+    user.mkdir(parents=True)
+    (user / "M.toml").write_text('[motor]\nreference = "M"\n\n[motor_data]\npole_pairs = "four"\n')
+    with pytest.raises(FileFormatError) as caught:
+        MotorCatalog(tmp_path / "builtin", user).motors()
+    assert str(caught.value) == "user motors/M.toml:5: motor data 'pole_pairs' must be an integer"
+
+
 def test_shipped_catalog_files_load():
     for path in sorted(BUILTIN_MOTORS_DIR.glob("*.toml")):
         assert motor_from_text(path.read_text(), path, builtin=True).reference == path.stem

@@ -109,7 +109,8 @@ def test_broken_axis_file_names_file_and_line(axis: ProjectService):
     path.write_text("0x3051,0=1\n0x2004,0=12\n")
     with pytest.raises(FileFormatError) as caught:
         axis.parameters.get("p", "X", "0x3051")
-    assert (caught.value.file, caught.value.line) == (str(path), 2)
+    assert (caught.value.file, caught.value.line) == ("p/X/DRIVEPAR.TXT", 2)  # its place in the project
+    assert str(path.parent) not in str(caught.value) and str(caught.value).startswith("p/X/DRIVEPAR.TXT:2: ")
     assert "expected text" in caught.value.reason
 
 

@@ -178,7 +178,8 @@ def test_hand_broken_project_file_names_file_and_line(sim_project: ProjectServic
     path.write_text(path.read_text() + '\n[axis.X]\ndevice = "xtrapulspac"\nnode_id = "one"\nbus = "sim"\n')
     with pytest.raises(FileFormatError) as caught:
         sim_project.store.open("p")
-    assert caught.value.file == str(path)
+    assert caught.value.file == "p/project.toml"  # its place in the project, not the server path
+    assert str(sim_project.store.root) not in str(caught.value)
     assert caught.value.line == path.read_text().splitlines().index('node_id = "one"') + 1
     assert "'node_id' must be an integer" in caught.value.reason
 

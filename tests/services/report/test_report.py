@@ -6,113 +6,27 @@ generated with no drive and checked for what it must hold."""
 from __future__ import annotations
 
 import hashlib
-import json
-import math
-import shutil
-from dataclasses import replace
-from html.parser import HTMLParser
-from pathlib import Path
 
 import pytest
-from tests.services.procedures.conftest import open_bench
-from tests.services.procedures.test_procedures_plants import commission
+from tests.services.report.support import Page, plotted
+from tests.services.report.support import commissioned as commission_project
 
-from servostudio.od import builtin_library
 from servostudio.services.audit import Actor, AuditLog, acting_as
 from servostudio.services.frequency import store as frequency_store
-from servostudio.services.procedures.recording import record
-from servostudio.services.procedures.store import ResultStore
-from servostudio.services.projects import ProjectService
 from servostudio.services.report import report_html
-from servostudio.services.scope import CaptureDefinition, CaptureStore
-from servostudio.services.scope.service import identity_of
 
-DEMO = Path(__file__).parents[3] / "projects" / "demo"
 HOSTILE = '<script>alert("x")</script><img src=x onerror=alert(1)>'
-
-
-class Page(HTMLParser):
-    """What the tests look for in the document: script tags and their sources, element ids, text."""
-
-    def __init__(self, html: str) -> None:
-        super().__init__()
-        self.scripts: list[dict[str, str | None]] = []
-        self.ids: set[str] = set()
-        self.text: list[str] = []
-        self.feed(html)
-        self.close()
-
-    def handle_starttag(self, tag: str, attrs: list[tuple[str, str | None]]) -> None:
-        if tag == "script":
-            self.scripts.append(dict(attrs))
-        self.ids.update(value for key, value in attrs if key == "id" and value)
-
-    def handle_data(self, data: str) -> None:
-        self.text.append(data)
-
-
-def plotted(html: str, div_id: str) -> list[dict]:
-    """The traces plotly draws in ``div_id``, read back from the page's own script."""
-    start = html.index(f'Plotly.newPlot(                        "{div_id}",')
-    data = html.index("[", start)
-    return json.JSONDecoder().raw_decode(html, data)[0]
 
 
 @pytest.fixture(scope="module")
 def commissioned(tmp_path_factory):
     """The project after a commissioning of seed 101's hidden plant, with every record saved under axis X."""
     root = tmp_path_factory.mktemp("store")
-    shutil.copytree(DEMO, root / "demo")
     audit = AuditLog(root / "audit.jsonl")
-    projects = ProjectService(root, builtin_library(), audit=audit)
-    bench = open_bench("1", seed=101, speed=5.0)
-    try:
-        plant, current, phasing, tuning = commission(bench, 75)
-        drive = bench.machine()
-        capture = record(drive, CaptureDefinition(channels=("velocity_actual",), period_us=500.0, samples=50),
-                         lambda event: None)  # fmt: skip
-        capture = replace(capture, drive=identity_of(bench.connection, drive))
-    finally:
-        bench.manager.close_all()
-    results = ResultStore(projects.store)
+    made = commission_project(root, audit)
     with acting_as(Actor("alice", "expert")):
-        for name, result in (("current_loop", current), ("auto_phasing", phasing), ("auto_tuning", tuning)):
-            results.save("demo", "X", name, result)
-        CaptureStore(projects.store).save("demo", "X", capture, "identity")
-        frequency_store.save(projects.store, "demo", "X", bode_of(plant), "plant sweep")
-        projects.parameters.set("demo", "X", {"0x6410,11": 250})
-        projects.store.edit_axis("demo", "Y", description=HOSTILE)
-    return projects, audit, plant, tuning, phasing, capture
-
-
-def bode_of(plant) -> dict:
-    """A plant frequency response in the contract's shape (docs/frequency-response.md), of the true plant."""
-    points = []
-    for number in range(20):
-        frequency = 5.0 * 1.2**number
-        response = 1 / complex(plant.viscous_friction, 2 * math.pi * frequency * plant.total_inertia)
-        points.append(
-            {
-                "freq_hz": frequency,
-                "magnitude_db": 20 * math.log10(abs(response)),
-                "phase_deg": math.degrees(math.atan2(response.imag, response.real)),
-                "coherence": 0.99,
-            }
-        )
-    return {
-        "kind": "frequency_response",
-        "loop": "plant",
-        "node": 1,
-        "device": "xtrapulspac",
-        "axis": "X",
-        "time": "2026-12-02T05:01:02Z",
-        "user": "bob",
-        "excitation": {"type": "multisine", "from_hz": 5},
-        "points": points,
-        "markers": {"bandwidth_hz": None, "resonance_hz": 180.0},
-        "plant_fit": {"inertia_kgm2": 1.234e-4, "viscous_friction_nms_per_rad": 5.6e-5},
-        "aborted": None,
-    }
+        made.projects.store.edit_axis("demo", "Y", description=HOSTILE)
+    return made.projects, audit, made.plant, made.tuning, made.phasing, made.capture
 
 
 def test_the_report_holds_the_commissioning_of_the_axis(commissioned):

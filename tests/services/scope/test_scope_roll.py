@@ -80,7 +80,8 @@ def test_a_cut_link_is_a_reported_gap_and_the_roll_goes_on(connection, socketcan
     cut: list[dict] = []
     stream = rolled(connection, 1, 4.0, events, cut_once)
     gaps = [event for event in events if event["type"] == "gap"]
-    assert len(gaps) == 1 and "link lost" in gaps[0]["reason"], gaps
+    # the link's loss, or (on a loaded host, when the SYNCs' silence is noticed first) the unanswered SYNCs
+    assert len(gaps) == 1 and any(cause in gaps[0]["reason"] for cause in ("link lost", "SYNC unanswered")), gaps
     numbers, _ = samples_of(events)
     start, end = gaps[0]["from"], gaps[0]["to"]
     assert end - start >= 300  # the cut lasted 0.5 s at 1 kHz: those sequence numbers are missing, said so

@@ -95,6 +95,22 @@ class ParameterList(BaseModel):
     revision: str
 
 
+class ValueChangeModel(BaseModel):
+    index: int
+    subindex: int
+    name: str
+    unit: str
+    old: Scalar
+    new: Scalar
+
+
+class DcfImportModel(BaseModel):
+    parameters: list[ParameterModel] = Field(description="the objects the DCF's configured values set")
+    changes: list[ValueChangeModel] = Field(description="the project values that change, old and new")
+    skipped: list[str] = Field(description="configured values the project cannot hold, each with its reason")
+    revision: str = Field(description="the new revision; with dry_run, the current one (nothing was written)")
+
+
 class ParameterWrite(BaseModel):
     values: dict[str, int | float | str] = Field(examples=[{"0x6060": -3, "0x60F9,2": 1200}])
     revision: str | None = None
@@ -110,6 +126,7 @@ class KeptRevisionModel(BaseModel):
     saved_at: float = Field(description="when it was replaced (epoch seconds)")
     reason: str = Field(description="what replaced it")
     files: int
+    by: str = Field(description="who made the change that replaced it (empty when not recorded)")
 
 
 class RevisionRestore(BaseModel):

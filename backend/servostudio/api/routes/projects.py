@@ -15,7 +15,7 @@ from pathlib import Path
 from typing import Annotated
 
 import anyio
-from fastapi import APIRouter, Query, Request, Response
+from fastapi import APIRouter, File, Query, Request, Response, UploadFile
 from fastapi.responses import FileResponse
 from starlette.background import BackgroundTask
 from starlette.concurrency import run_in_threadpool
@@ -24,6 +24,7 @@ from servostudio.api.deps import Live, Projects
 from servostudio.api.errors import error_responses
 from servostudio.api.limits import body_limit
 from servostudio.api.routes import projects_live
+from servostudio.api.routes.dictionaries import EDS_UPLOAD_BYTES
 from servostudio.api.routes.drives import DRIVE_ERRORS
 from servostudio.api.routes.project_models import (
     AxisChoiceModel,
@@ -31,6 +32,7 @@ from servostudio.api.routes.project_models import (
     AxisUpdate,
     CompareModel,
     CompareRowModel,
+    DcfImportModel,
     KeptRevisionModel,
     MotorChoice,
     MotorModel,
@@ -46,12 +48,14 @@ from servostudio.api.routes.project_models import (
     RevisionRestore,
     TemplateChoice,
     TemplateModel,
+    ValueChangeModel,
     buses_from,
     parameter_model,
     project_model,
 )
 from servostudio.api.security import Requires
 from servostudio.errors import ErrorKind
+from servostudio.services import dictionaries
 from servostudio.services.projects import ArchiveLimits, Axis, Motor, errors
 from servostudio.services.projects.jsonview import (
     choice_view,
@@ -59,6 +63,7 @@ from servostudio.services.projects.jsonview import (
     motor_view,
     summaries,
     template_view,
+    value_change_view,
 )
 from servostudio.services.projects.templates import templates_for
 from servostudio.services.users import Level
@@ -315,6 +320,43 @@ def export_dcf(name: str, axis: str, service: Projects) -> Response:
         text.encode("latin-1"),
         media_type="text/plain; charset=latin-1",
         headers={"Content-Disposition": f'attachment; filename="{axis}.dcf"'},
+    )
+
+
+#: a DCF is an EDS with values: the EDS upload's limit
+DCF_UPLOAD_BYTES = EDS_UPLOAD_BYTES
+
+
+@router.post(
+    "/projects/{name}/axes/{axis}/dcf",
+    response_model=DcfImportModel,
+    responses=error_responses(ErrorKind.INVALID_INPUT, ErrorKind.TOO_LARGE),
+    openapi_extra=body_limit(DCF_UPLOAD_BYTES),
+    dependencies=[Requires(Level.EXPERT)],
+)
+async def import_dcf(
+    name: str,
+    axis: str,
+    service: Projects,
+    dcf: Annotated[UploadFile, File(description="CiA 306 DCF of the axis's device")],
+    revision: Annotated[str | None, Query()] = None,
+    dry_run: Annotated[bool, Query(description="check and answer what would change, write nothing")] = False,
+) -> DcfImportModel:
+    """Set the axis's offline values to what the DCF configures (``ParameterValue``, ``$NODEID`` resolved for the
+    axis), all or nothing, checked like offline edits; ``changes`` lists the values that change (old, new),
+    ``skipped`` what the project cannot hold. The project as it was is kept as a revision. Errors name the file as
+    uploaded."""
+    text = dictionaries.upload_text(await dcf.read())
+    file_name = dcf.filename or "upload.dcf"
+    if dry_run:
+        imported = await run_in_threadpool(service.preview_dcf, name, axis, text, file_name)
+    else:
+        imported = await run_in_threadpool(service.import_dcf, name, axis, text, file_name, revision)
+    return DcfImportModel(
+        parameters=[parameter_model(row) for row in imported.change.rows],
+        changes=[ValueChangeModel(**value_change_view(change)) for change in imported.changes],
+        skipped=imported.skipped,
+        revision=imported.change.revision,
     )
 
 

@@ -110,7 +110,9 @@ def start_roll(request: RollRequest, connection: OpenBus, drive: NodeDrive, jobs
 async def roll_socket(socket: WebSocket, roll: str, scope: ScopeCaptures, jobs: Jobs, control: Access) -> None:
     """A roll's events as JSON: ``samples`` (``seq`` of the first, ``count``, ``values`` per channel in physical
     units, ``synced_at`` of the first and last sample's SYNC, Unix s), ``gap`` (``from``, ``to``, ``reason``) and
-    ``end`` (the summary). The client may send ``{"type": "stop"}`` (Operator) to end the roll."""
+    ``end`` (the summary). The client may send ``{"type": "stop"}`` (Operator) to end the roll. A roll without
+    ``seconds`` ends when its last socket closes (nobody would stop it otherwise: it would hold the axes and the
+    bus's SYNC for good)."""
     await socket.accept()
     try:
         feed = scope.feed(roll)
@@ -118,12 +120,15 @@ async def roll_socket(socket: WebSocket, roll: str, scope: ScopeCaptures, jobs: 
         await socket.close(code=4404, reason=str(error))
         return
     receiver = asyncio.create_task(_roll_messages(socket, control, lambda: jobs.cancel(roll)))
+    feed.join(+1)
     try:
         await _send_roll(socket, feed, receiver)
     except (WebSocketDisconnect, RuntimeError):  # RuntimeError: sending after the client closed
         pass
     finally:
         receiver.cancel()
+        if feed.join(-1):
+            jobs.cancel(roll)
 
 
 async def _send_roll(socket: WebSocket, feed: RollFeed, receiver: asyncio.Task[None]) -> None:

@@ -69,7 +69,12 @@ def read_project(name: str, axis: str, service: Projects) -> dict[str, object]:
     return {"text": text, "revision": revision}
 
 
-@router.put(AXIS, response_model=ProjectSequences, dependencies=[Requires(Level.EXPERT)])
+@router.put(
+    AXIS,
+    response_model=ProjectSequences,
+    dependencies=[Requires(Level.EXPERT)],
+    responses=error_responses(ErrorKind.TOO_LARGE),  # a SEQUENCE.TXT beyond the request size limit
+)
 def write_project(name: str, axis: str, body: ProjectSequencesWrite, service: Projects) -> dict[str, object]:
     """Checked by the file reader first: a file with an error is refused whole (422) and nothing is written."""
     revision = project_file.write_text(service, name, axis, body.text, body.revision)
@@ -89,7 +94,7 @@ def upload(drive: NodeDrive) -> dict[str, object]:
     NODE,
     response_model=DownloadModel,
     dependencies=[Requires(Level.MAINTENANCE)],
-    responses=error_responses(ErrorKind.COMMUNICATION),
+    responses=error_responses(ErrorKind.COMMUNICATION, ErrorKind.TOO_LARGE),
 )
 def download(drive: NodeDrive, body: DownloadRequest) -> dict[str, object]:
     """Validate the whole file against the drive, write it (LOAD or MERGE), verify, store if asked."""

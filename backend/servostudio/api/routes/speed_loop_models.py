@@ -24,6 +24,9 @@ class SpeedLoopModel(BaseModel):
     kd_a_per_rad_s2: float
     current_filters_hz: list[float] = Field(description="the drive's first-order current-command filters, 0 = off")
     speed_filter_s: float = Field(description="time constant of the speed-measurement filter")
+    speed_filter_choices_s: list[float] = Field(
+        default=[], description="the speed-filter time constants a PUT takes (empty: the filter is fixed)"
+    )
     writable: list[str] = Field(description="the keys a PUT takes on this drive")
     raw: dict[str, int] = Field(description="semantic object name → raw value read")
 

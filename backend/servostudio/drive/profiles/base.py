@@ -14,6 +14,7 @@ from servostudio.errors import NotFound
 from servostudio.od.model import SaveType
 
 if TYPE_CHECKING:  # the recorder module builds on this one's ProfileError
+    from servostudio.drive.profiles.io import IoDescription
     from servostudio.drive.profiles.recorder import RecorderDescription
 
 #: Objects every CiA 301 device has, and those of a CiA 402 drive, by semantic name.
@@ -57,6 +58,17 @@ CIA402_OBJECTS: dict[str, tuple[int, int]] = {
     "velocity_offset": (0x60B1, 0),
     "torque_offset": (0x60B2, 0),
     "interpolation_data": (0x60C1, 1),
+}
+#: The CiA 402 torque and current objects (a drive family whose currents are shares of something else, the CD1-k,
+#: does not name them)
+CIA402_TORQUE_OBJECTS: dict[str, tuple[int, int]] = {
+    "velocity_demand": (0x606B, 0),
+    "max_torque": (0x6072, 0),
+    "max_current": (0x6073, 0),
+    "rated_current": (0x6075, 0),
+    "rated_torque": (0x6076, 0),
+    "torque_actual": (0x6077, 0),
+    "current_actual": (0x6078, 0),
 }
 #: The CiA 402 objects that set an axis moving or change how it moves: the control word, the mode, the targets
 #: and offsets, the motion profile.  Only the axis's controller may write them (``services.motion``).
@@ -165,6 +177,12 @@ class DeviceProfile:
     procedures: ProcedureSet = NO_PROCEDURES
     #: the speed loop's gain and filter objects and their scalings; None: the drive has no gain objects
     speed_loop: SpeedLoopDescription | None = None
+    #: the logic inputs, outputs, analog I/O, encoder emulation and I/O extension (``drive/profiles/io.py``)
+    io: IoDescription | None = None
+    #: rad/s of one speed unit (0x606C, 0x60FF, 0x607F) and rad/s² of one acceleration unit (0x6083, 0x6084) when the
+    #: drive does not count them in position units per second (encoTRive: rpm and rpm/s); None: position units
+    speed_unit_rad_s: float | None = None
+    acceleration_unit_rad_s2: float | None = None
 
     def address(self, name: str) -> tuple[int, int]:
         try:
@@ -196,6 +214,6 @@ def generic_profile(device: str) -> DeviceProfile:
     """Plain CiA 301 + 402: standard objects and the standard 'save' signature."""
     return DeviceProfile(
         device=device,
-        objects={**CIA301_OBJECTS, **CIA402_OBJECTS},
+        objects={**CIA301_OBJECTS, **CIA402_OBJECTS, **CIA402_TORQUE_OBJECTS},
         signatures={"save": ("store_parameters", "save"), "load": ("restore_parameters", "load")},
     )

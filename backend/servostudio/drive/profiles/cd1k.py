@@ -10,9 +10,17 @@ remark on the fault, with the objects its other chapters name for the same prote
 from __future__ import annotations
 
 from servostudio.drive.faults import CodedBits, FaultInfo
-from servostudio.drive.profiles.base import CIA301_OBJECTS, CIA402_OBJECTS, Addressing, DeviceProfile, EmcyLayout
+from servostudio.drive.profiles.base import (
+    CIA301_OBJECTS,
+    CIA402_MOTION_OBJECTS,
+    CIA402_OBJECTS,
+    Addressing,
+    DeviceProfile,
+    EmcyLayout,
+)
 from servostudio.drive.profiles.cd1k_procedures import CD1K_PROCEDURES
 from servostudio.drive.profiles.homing import HOMING_METHODS
+from servostudio.drive.profiles.io import CD1K_IO, CD1K_IO_MOTION_OBJECTS, CD1K_IO_OBJECTS
 from servostudio.drive.profiles.procedures import IDENTIFIED_PLANT_OBJECTS
 from servostudio.drive.profiles.speed_loop import CD1K_SPEED_LOOP
 
@@ -167,6 +175,7 @@ CD1K = DeviceProfile(
         "digital_output_mask": (0x60FE, 2),
         "velocity_demand": (0x606B, 0),
         "encoder_increments": (0x608F, 1),
+        **CD1K_IO_OBJECTS,
     },
     signatures={"save": ("store_parameters", "save")},
     error_words=(("drive_error_word", 1),),
@@ -190,4 +199,6 @@ CD1K = DeviceProfile(
     procedures=CD1K_PROCEDURES,
     speed_loop=CD1K_SPEED_LOOP,
     homing_methods=HOMING_METHODS,
+    motion_objects=CIA402_MOTION_OBJECTS | CD1K_IO_MOTION_OBJECTS,
+    io=CD1K_IO,
 )

@@ -8,11 +8,11 @@ from __future__ import annotations
 
 from servostudio.drive.profiles.procedures import (
     IDENTIFIED_PLANT,
-    PHASING_RESULTS,
     OptionCodes,
     ProcedureDescription,
     ProcedureSet,
     UserUnits,
+    phasing_procedures,
 )
 
 _PHASING_CHECKS = ("not_running", "disabled", "no_fault", "no_limit_switch")
@@ -30,28 +30,7 @@ TUNED = (
 
 CD1K_PROCEDURES = ProcedureSet(
     {
-        "auto_phasing": ProcedureDescription(
-            "Auto-phasing",
-            "auto_phasing",
-            "apha",
-            moves=True,
-            preconditions=_PHASING_CHECKS,
-            inputs=_CURRENTS,
-            results=PHASING_RESULTS,
-            duration_s=8.0,
-            timeout_s=90.0,
-        ),
-        "motor_phasing": ProcedureDescription(
-            "Motor phasing",
-            "motor_phasing",
-            "mcal",
-            moves=True,
-            preconditions=_PHASING_CHECKS,
-            inputs=(*_CURRENTS, "pole_pairs"),
-            results=("sensor_offset",),
-            duration_s=2.0,
-            timeout_s=60.0,
-        ),
+        **phasing_procedures(_PHASING_CHECKS, _CURRENTS),
         "auto_tuning": ProcedureDescription(
             "Auto-tuning",
             "auto_tuning",

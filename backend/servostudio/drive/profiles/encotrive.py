@@ -8,8 +8,17 @@ its standard name, with the manual's error register class and its general rule f
 
 from __future__ import annotations
 
+import math
+
 from servostudio.drive.faults import FaultInfo
-from servostudio.drive.profiles.base import CIA301_OBJECTS, CIA402_OBJECTS, Addressing, DeviceProfile
+from servostudio.drive.profiles.base import (
+    CIA301_OBJECTS,
+    CIA402_OBJECTS,
+    CIA402_TORQUE_OBJECTS,
+    Addressing,
+    DeviceProfile,
+)
+from servostudio.drive.profiles.io import ENCOTRIVE_IO
 
 _EMCY = {
     info.cia402_code: info
@@ -51,21 +60,34 @@ _ACKNOWLEDGE = (
 #: a 0 in any of them keeps the axis still without a fault
 _RAMP_LIMITS = ("profile_acceleration", "max_acceleration", "profile_deceleration", "max_deceleration")
 
+_RPM = 2.0 * math.pi / 60.0
+
 ENCOTRIVE = DeviceProfile(
     device="encotrive",
     objects={
         **CIA301_OBJECTS,
         **CIA402_OBJECTS,
+        **CIA402_TORQUE_OBJECTS,
         "error_history": (0x1003, 1),
         "max_acceleration": (0x60C5, 0),
         "max_deceleration": (0x60C6, 0),
+        "digital_inputs": (0x60FD, 0),
+        "digital_outputs": (0x60FE, 1),
+        "digital_output_mask": (0x60FE, 2),
+        "encoder_increments": (0x608F, 1),
+        "position_factor_numerator": (0x6093, 1),
+        "position_factor_denominator": (0x6093, 2),
     },
     signatures={"save": ("store_parameters", "save"), "load": ("restore_parameters", "load")},
     emcy_codes=_EMCY,
     error_code_remedy=_ACKNOWLEDGE,
     addressing=Addressing(reason="encoTRive node IDs are 1-127"),
+    #: the factory velocity and acceleration factors 6094h / 6097h: speeds in rpm, accelerations in rpm/s (Formula 8-11)
+    speed_unit_rad_s=_RPM,
+    acceleration_unit_rad_s2=_RPM,
     mode_limits={
         1: ("profile_velocity", "max_profile_velocity", *_RAMP_LIMITS),
         3: ("max_profile_velocity", *_RAMP_LIMITS),
     },
+    io=ENCOTRIVE_IO,
 )

@@ -116,3 +116,18 @@ IDENTIFIED_PLANT = {
     "residual": "identified_residual",
 }
 IDENTIFIED_PLANT_OBJECTS = {name: (0x3428, sub) for sub, name in enumerate(IDENTIFIED_PLANT.values(), start=1)}
+
+
+def phasing_procedures(checks: tuple[str, ...], currents: tuple[str, ...]) -> dict[str, ProcedureDescription]:
+    """Auto-phasing (``apha``) and motor phasing (``mcal``) as the Infranor drives share them: the same objects and
+    results; a drive differs only in the checks before the start and the current inputs its motor data has."""
+    return {
+        "auto_phasing": ProcedureDescription(
+            "Auto-phasing", "auto_phasing", "apha", moves=True, preconditions=checks, inputs=currents,
+            results=PHASING_RESULTS, duration_s=8.0, timeout_s=90.0,
+        ),
+        "motor_phasing": ProcedureDescription(
+            "Motor phasing", "motor_phasing", "mcal", moves=True, preconditions=checks,
+            inputs=(*currents, "pole_pairs"), results=("sensor_offset",), duration_s=2.0, timeout_s=60.0,
+        ),
+    }  # fmt: skip

@@ -11,6 +11,7 @@ from servostudio.drive.profiles.base import (
     EmcyLayout,
 )
 from servostudio.drive.profiles.homing import HOMING_METHODS
+from servostudio.drive.profiles.io import XTRAPULSPAC_IO, XTRAPULSPAC_IO_MOTION_OBJECTS, XTRAPULSPAC_IO_OBJECTS
 from servostudio.drive.profiles.procedures import IDENTIFIED_PLANT_OBJECTS
 from servostudio.drive.profiles.recorder import XTRAPULSPAC_RECORDER
 from servostudio.drive.profiles.speed_loop import XTRAPULSPAC_SPEED_LOOP
@@ -60,6 +61,8 @@ XTRAPULSPAC = DeviceProfile(
         "motor_torque_constant": (0x6410, 11),
         "max_current": (0x6073, 0),
         "rated_current": (0x6075, 0),
+        "current_actual": (0x6078, 0),
+        "current_monitor_filter": (0x3078, 0),  # the frequency response opens it while it records 0x6078
         "pole_pairs": (0x3410, 1),
         # procedures (services.procedures; drive/profiles/xtrapulspac_procedures.py)
         "phase_order": (0x3410, 2),
@@ -105,6 +108,7 @@ XTRAPULSPAC = DeviceProfile(
         "torque_slope": (0x6087, 0),
         "position_demand": (0x6062, 0),
         "velocity_monitor_filter": (0x306C, 0),
+        **XTRAPULSPAC_IO_OBJECTS,
     },
     signatures={
         "save": ("store_parameters", "save"),
@@ -142,7 +146,8 @@ XTRAPULSPAC = DeviceProfile(
         "sequence_number_input",
         "sequence_conditional_input",
         "sim_physical_inputs",
-    },
+    }
+    | XTRAPULSPAC_IO_MOTION_OBJECTS,
     # phasing turns the rotor through an electrical turn or more, auto-tuning with current pulses (manual §3.5)
     moving_procedures={"auto_phasing": "apha", "motor_phasing": "mcal", "auto_tuning": "atun"},
     # error 64 "Procedure error" says only that one failed; what each needs non-zero (manual §3.2.2.2, §3.2.2.9):
@@ -157,4 +162,5 @@ XTRAPULSPAC = DeviceProfile(
     procedures=XTRAPULSPAC_PROCEDURES,
     speed_loop=XTRAPULSPAC_SPEED_LOOP,
     homing_methods=HOMING_METHODS,
+    io=XTRAPULSPAC_IO,
 )

@@ -64,6 +64,7 @@ def read_speed_loop(drive: Drive) -> dict[str, Any]:
     result.setdefault("ki_leak_hz", 0.0)
     result["current_filters_hz"] = [float(raw.get(name, 0)) for name in loop.current_filters if name in raw]
     result[SPEED_FILTER_KEY] = _speed_filter_s(loop, raw)
+    result["speed_filter_choices_s"] = sorted(loop.speed_filter_s.values()) if loop.speed_filter is not None else []
     result["writable"] = writable(drive)
     result["raw"] = raw
     return result
@@ -165,16 +166,15 @@ def _choose_multiplier(loop: SpeedLoopDescription, values: Mapping[str, float]) 
     scaled = [values[key] / scale.unit for key, scale in loop.gains.items() if scale.scaled and key in values]
     largest = max(scaled, default=0.0)
     for shift in range(MAX_MULTIPLIER_SHIFT + 1):
-        if round(largest / 2**shift) <= 0xFFFF:
+        if largest / 2**shift < 0xFFFF + 0.5:  # compared before rounding: a huge value (even inf) is refused
             return float(2**shift)
     raise BadSpeedLoop(f"a speed-loop gain of {largest:.4g} counts is out of range even with the largest multiplier")
 
 
 def _count(value: float, key: str) -> int:
-    count = round(value)
-    if count > 0xFFFF:
-        raise BadSpeedLoop(f"{key}: {count} counts is out of range (0..65535)")
-    return count
+    if not value < 0xFFFF + 0.5:
+        raise BadSpeedLoop(f"{key}: {value:.6g} counts is out of range (0..65535)")
+    return round(value)
 
 
 def _filter_writes(loop: SpeedLoopDescription, physical: Mapping[str, float]) -> list[tuple[str, int]]:

@@ -26,7 +26,7 @@ from servostudio.services.audit import Actor
 from servostudio.services.motion.control import Axis, where
 from servostudio.services.motion.hold import HoldWatch
 from servostudio.services.motion.limits import LimitStore
-from servostudio.services.motion.units import rpm_to_units, units_per_revolution
+from servostudio.services.motion.units import rpm_to_speed, units_per_revolution
 
 if TYPE_CHECKING:
     from servostudio.services.motion.guard import MotionGuard
@@ -114,8 +114,7 @@ class Motions:
             raise InvalidInput("a jog needs 'seconds' or 'hold': it must end by itself or when released")
         if seconds is not None:
             limits.check_seconds(axis, seconds)
-        per_revolution = units_per_revolution(drive)
-        writes = [("modes_of_operation", PROFILE_VELOCITY), ("target_velocity", rpm_to_units(velocity, per_revolution))]
+        writes = [("modes_of_operation", PROFILE_VELOCITY), ("target_velocity", rpm_to_speed(drive, velocity))]
         request = {"velocity": velocity, "seconds": seconds}
         run = self._begin(actor, axis, drive, "jog", hold, request)
         return self._launch(run, writes, None, self._jog_finished(run, seconds))
@@ -143,7 +142,7 @@ class Motions:
         limits.check_distance(axis, travel / per_revolution)
         writes = [
             ("modes_of_operation", PROFILE_POSITION),
-            ("profile_velocity", rpm_to_units(speed, per_revolution)),
+            ("profile_velocity", rpm_to_speed(drive, speed)),
             ("target_position", target),
         ]
         request = {"distance": distance, "absolute": absolute, "velocity": speed}
@@ -162,8 +161,7 @@ class Motions:
         writes: list[tuple[str, int]] = [("modes_of_operation", HOMING), ("homing_method", method)]
         if velocity is not None:
             self.limits.of(axis).check_velocity(axis, velocity)
-            per_revolution = units_per_revolution(drive)
-            fast = max(1, rpm_to_units(abs(velocity), per_revolution))
+            fast = max(1, rpm_to_speed(drive, abs(velocity)))
             writes += [("homing_speed_fast", fast), ("homing_speed_slow", max(1, fast // 4))]
         run = self._begin(actor, axis, drive, "home", hold, {"method": method, "velocity": velocity})
         return self._launch(run, writes, _set_point(0), _homing_finished)

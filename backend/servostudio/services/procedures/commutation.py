@@ -31,6 +31,11 @@ SHIFT = 65536 // 8  # 45° electrical in sensor-offset units (65536 = one electr
 PASS_RATIO = 0.98
 PULSE_SAMPLES = 120
 PERIOD_US = 250.0
+PRE_TRIGGER_PCT = 10.0
+#: the pulse lasts this much longer than the recording after its trigger (the trigger is a sample late)
+PULSE_MARGIN = 1.2
+#: the reverse torque after a pulse, as a share of the time the pulse was on (friction brakes the rest)
+REVERSE_SHARE = 0.8
 SKIP_S = 0.001  # the current's rise at the start of a pulse
 TARGET_ACCELERATION = 1500.0  # rad/s², on the motor's own inertia
 SLOPE = 1_000_000  # ‰/s: a torque step
@@ -94,34 +99,52 @@ def _pulse(drive: Drive, offset: int, level: int) -> float:
         period_us=PERIOD_US,
         samples=PULSE_SAMPLES,
         trigger=Trigger("target_torque", edge, level / 20),  # physical: % of the rated current
-        pre_trigger_pct=10.0,
+        pre_trigger_pct=PRE_TRIGGER_PCT,
         timeout_s=10.0,
     )
 
     def report(event: dict[str, object]) -> None:
         if event.get("stage") == "waiting":
-            drive.write("target_torque", level)
-        elif event.get("stage") == "done":
-            _stop(drive, abs(level))  # at rest before the recording is read
+            _push(drive, level)
+            _stop(drive, abs(level))
 
-    capture = record(drive, definition, report)
+    try:
+        capture = record(drive, definition, report)
+    finally:
+        _stop(drive, abs(level))  # whatever became of the recording, the axis is at rest before it is disabled
     disable(drive)
     slope = _slope(drive, capture.times_s(), capture.physical(0), capture.physical(1), level)
     return slope if level > 0 else -slope
+
+
+def _push(drive: Drive, level: int) -> None:
+    """The pulse and its mirror, timed by the tool rather than by the recorder's status: the torque is on for the
+    recording's post-trigger time (the first sample past the trigger is the pulse's start), then reversed for
+    about as long as it was on, which takes most of the speed back (friction helps: a little shorter); ``_stop``
+    takes the rest. A pulse that ends early shows in the recorded target, and only the samples at full torque are
+    fitted."""
+    drive.write("target_torque", level)
+    began = time.monotonic()
+    time.sleep(PULSE_SAMPLES * PERIOD_US * 1e-6 * (1 - PRE_TRIGGER_PCT / 100) * PULSE_MARGIN)
+    drive.write("target_torque", -level)
+    time.sleep((time.monotonic() - began) * REVERSE_SHARE)
+    drive.write("target_torque", 0)
 
 
 def _stop(drive: Drive, level: int) -> None:
     """Bring the axis to rest with reverse torque, each stage a quarter of the last (a bus round trip late, the
     reverse torque overshoots; the next, weaker stage takes that back), then no torque."""
     unit = speed_rad_s(drive, 1.0)
-    for stage in (level, level // 4, level // 16):
+    stage = level
+    while stage >= 1:
         speed = float(drive.read("velocity_actual").raw) * unit
-        if abs(speed) < REST_RAD_S or stage < 1:
+        if abs(speed) < REST_RAD_S:
             break
         drive.write("target_torque", -stage if speed > 0 else stage)
         deadline = time.monotonic() + STOP_WAIT
         while time.monotonic() < deadline and float(drive.read("velocity_actual").raw) * unit * speed > 0:
             pass  # one read after the other: the reverse torque must end as soon as the axis stands
+        stage //= 4
     drive.write("target_torque", 0)
 
 

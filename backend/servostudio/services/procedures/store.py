@@ -10,6 +10,7 @@ from datetime import UTC, datetime
 from pathlib import Path
 
 from servostudio.errors import InvalidInput
+from servostudio.services.audit import current_actor
 from servostudio.services.projects.fsutil import atomic_write
 from servostudio.services.projects.layout import PROCEDURES_DIR, TEMP_PREFIX
 from servostudio.services.projects.store import ProjectStore
@@ -33,7 +34,9 @@ class ResultStore:
             view.axis(axis)
 
     def save(self, project: str, axis: str, name: str, result: dict[str, object], when: datetime | None = None) -> str:
-        """Write the result; returns its path in the project (``<axis>/procedures/<file>``)."""
+        """Write the result with who ran it (the acting user: the report's "who"); returns its path in the project
+        (``<axis>/procedures/<file>``)."""
+        result = {**result, "user": result.get("user") or current_actor().user}
         moment = (when or datetime.now(UTC)).strftime("%Y%m%dT%H%M%S.%fZ")
         with self.projects.edit(project) as edit:
             directory = edit.axis_directory(axis) / PROCEDURES_DIR

@@ -22,11 +22,14 @@ def units_per_revolution(drive: Drive) -> float:
 
 
 def speed_rad_s(drive: Drive, user_per_s: float) -> float:
-    return user_per_s / units_per_revolution(drive) * TWO_PI
+    """rad/s of a speed in the drive's speed unit (the profile's own, e.g. the encoTRive's rpm, else units/s)."""
+    unit = drive.profile.speed_unit_rad_s
+    return user_per_s * unit if unit else user_per_s / units_per_revolution(drive) * TWO_PI
 
 
 def user_speed(drive: Drive, rad_s: float) -> float:
-    return rad_s / TWO_PI * units_per_revolution(drive)
+    unit = drive.profile.speed_unit_rad_s
+    return rad_s / unit if unit else rad_s / TWO_PI * units_per_revolution(drive)
 
 
 def _value(drive: Drive, name: str, default: float) -> float:

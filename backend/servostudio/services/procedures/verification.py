@@ -1,17 +1,19 @@
-"""The verification after auto-tuning (docs/commissioning.md §5): a speed step, and in minimum-overshoot mode a
-position step, recorded with the capture service while the axis is enabled through the motion guard (the run's
-actor is the axis's armed controller), then disabled again with every value it changed put back.
+"""The verification after auto-tuning (docs/commissioning.md §5): speed steps, and when the tuning ran in a position
+mode (it computed the position loop too) a position step, recorded with the capture service while the axis is
+enabled through the motion guard (the run's actor is the axis's armed controller), then disabled again with every
+value it changed put back.
 
-The step is small enough that the current stays below its limit (a saturated loop says nothing about its
-bandwidth): Δω = ½ of the rated current's torque over J·ω of the requested bandwidth, from the identified inertia
-and the torque constant. It starts from a small base speed, not from rest (Coulomb friction, see BASE_SHARE). A
-drive without a recorder gets no verification (``skipped`` says why).
+The steps are small enough that the current stays below its limit (a saturated loop says nothing about its
+bandwidth): Δω = I_step·Kt / (J·ω) of the requested bandwidth, from the identified inertia and the torque constant,
+I_step the rated current but at most half the max current. They start from a small base speed, not from rest
+(Coulomb friction, see BASE_SHARE), and alternate in direction. A drive without a recorder gets no verification
+(``skipped`` says why).
 """
 
 from __future__ import annotations
 
 import time
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Mapping, Sequence
 from typing import TYPE_CHECKING, Any
 
 from servostudio.drive.access import Drive
@@ -20,7 +22,7 @@ from servostudio.drive.control import set_state
 from servostudio.services.procedures.commutation import verify_commutation
 from servostudio.services.procedures.recording import record
 from servostudio.services.procedures.run import disable, read_values, restore
-from servostudio.services.procedures.stepmetrics import step_metrics
+from servostudio.services.procedures.stepmetrics import Recording, mean_bandwidth, step_metrics, window
 from servostudio.services.procedures.units import TWO_PI, speed_rad_s, units_per_revolution, user_speed
 from servostudio.services.scope import Capture, CaptureDefinition, Trigger
 
@@ -28,6 +30,9 @@ if TYPE_CHECKING:
     from servostudio.services.procedures.run import ProcedureRun
 
 MODE_PP, MODE_PV = 1, 3
+#: CiA 402 profile position, interpolated position, cyclic synchronous position: a tuning in one of these computed
+#: the position loop too, and its verification steps the position as well
+POSITION_MODES = (1, 7, 8)
 PERIOD_US = 500.0
 SAMPLES = 800  # 0.4 s: a slow loop (anti-resonance filter) settles within it
 PRE_TRIGGER_PCT = 5.0
@@ -39,12 +44,18 @@ POSITION_STEP_REV = 0.05
 DEFAULT_STEP_RAD_S = 5.0
 #: the step's travel over the recording stays below a revolution (the manual: one free revolution)
 MAX_STEP_RAD_S = 9.0
-#: the step's current: the larger the step, the smaller the speed measurement's quantisation next to it
-STEP_CURRENT_SHARE = 0.5
+#: the step's current, the smaller of these shares of the rated and of the max current: the larger the step, the
+#: smaller the speed measurement's quantisation next to it (at ½ of the rated current one step read 53–80 Hz of a
+#: 62 Hz loop, at the full rated current 60–64 Hz), and the loop stays clear of its current limit
+STEP_CURRENT_SHARE = 1.0
+STEP_MAX_CURRENT_SHARE = 0.5
 #: the step starts from this share of its size in speed, never from standstill: Coulomb friction changes sign
 #: at zero speed, which makes a step from rest a load step too (measured: 0.64-0.75 x the loop's bandwidth)
 BASE_SHARE = 0.25
 RPM = 60.0 / TWO_PI
+#: recorded speed steps, alternating in direction (the travel nets out; the mean of their frequency responses
+#: averages the speed measurement's quantisation noise out of the bandwidth)
+SPEED_STEPS = 2
 
 
 def verify(run: ProcedureRun, result: dict[str, object], options: Mapping[str, Any]) -> dict[str, object] | None:
@@ -62,7 +73,7 @@ def verify(run: ProcedureRun, result: dict[str, object], options: Mapping[str, A
     start = int(drive.read("position_actual").raw)
     try:
         speed = _speed_step(drive, _step_size(drive, result, options))
-        position = _position_step(drive) if options.get("mode") == "min-overshoot" else None
+        position = _position_step(drive) if run.description.mode in POSITION_MODES else None
         _back_to(drive, start)
     finally:
         disable(drive)
@@ -78,35 +89,78 @@ def _step_size(drive: Drive, result: dict[str, object], options: Mapping[str, An
     if not isinstance(inertia, float) or inertia <= 0 or name is None or not drive.profile.has("rated_current"):
         return DEFAULT_STEP_RAD_S
     torque_constant = float(drive.read(name).physical)
-    current = float(drive.read("rated_current").physical)
+    current = _step_current(drive)
     omega = TWO_PI * float(options.get("bandwidth", 75))
-    step = STEP_CURRENT_SHARE * current * torque_constant / (inertia * omega)
+    step = current * torque_constant / (inertia * omega)
     return min(max(step, 1.0), MAX_STEP_RAD_S) if step > 0 else DEFAULT_STEP_RAD_S
 
 
+def _step_current(drive: Drive) -> float:
+    """A of the step: STEP_CURRENT_SHARE of the rated current, at most STEP_MAX_CURRENT_SHARE of the max current
+    (0x6073 is % of the rated current)."""
+    rated = float(drive.read("rated_current").physical)
+    if not drive.profile.has("max_current"):
+        return STEP_CURRENT_SHARE * rated
+    maximum = rated * float(drive.read("max_current").physical) / 100.0
+    return min(STEP_CURRENT_SHARE * rated, STEP_MAX_CURRENT_SHARE * maximum)
+
+
 def _speed_step(drive: Drive, step_rad_s: float) -> dict[str, object]:
-    """Profile velocity, enabled at standstill, then the target jumps; the recording gives the metrics."""
+    """Profile velocity, enabled at standstill, then SPEED_STEPS recorded steps of the target, alternating in
+    direction; the first step's metrics, and the bandwidth of their mean frequency response."""
     ramp = units_per_revolution(drive) * STEP_RAMP_REV_S2
     base = round(user_speed(drive, BASE_SHARE * step_rad_s))
-    target = base + round(user_speed(drive, step_rad_s))
-    values = {"target_velocity": base, "profile_acceleration": ramp, "profile_deceleration": ramp}
-    _prepare(drive, MODE_PV, values | _speed_limit(drive, 2 * abs(target)))
+    top = base + round(user_speed(drive, step_rad_s))
+    values = {"target_velocity": 0, "profile_acceleration": ramp, "profile_deceleration": ramp}
+    _prepare(drive, MODE_PV, values | _speed_limit(drive, 2 * abs(top)))
+    recordings = []
+    try:
+        for n in range(SPEED_STEPS):
+            sign = 1 if n % 2 == 0 else -1
+            recordings.append(_recorded_step(drive, sign * base, sign * top))
+    finally:
+        drive.write("target_velocity", 0)
+    return _speed_result(recordings, _measurement_filters(drive))
+
+
+def _speed_result(recordings: list[Recording], filters: tuple[float, ...]) -> dict[str, object]:
+    """The metrics of the first step that settled, and the bandwidth of the mean frequency response of all that
+    settled: a step that did not (a limit switch in its way, an axis that oscillates) says nothing about the loop's
+    bandwidth, and is listed with None."""
+    metrics = [step_metrics(*recording, filters) for recording in recordings]
+    settled = [n for n, one in enumerate(metrics) if one.settling_time_s is not None]
+    windows = [window(*recordings[n]) for n in settled]
+    shown = settled[0] if settled else 0
+    return {
+        **metrics[shown].as_dict(),
+        "bandwidth_hz": mean_bandwidth([w for w in windows if w is not None], filters) if settled else None,
+        "bandwidth_steps_hz": [one.bandwidth_hz if n in settled else None for n, one in enumerate(metrics)],
+        "capture": _shown(*recordings[shown], "rpm"),
+    }
+
+
+def _recorded_step(drive: Drive, start: int, end: int) -> Recording:
+    """One recorded step of the target velocity from ``start`` to ``end`` (user units/s), in rpm. The axis runs only
+    while the recorder waits and records: at ``start`` for SETTLE_S, then at ``end`` until the recording is complete,
+    then it stops (while the recording is read, the axis would travel on)."""
+
+    def step() -> None:
+        drive.write("target_velocity", start)
+        time.sleep(SETTLE_S)
+        drive.write("target_velocity", end)
+
     definition = CaptureDefinition(
         channels=("target_velocity", "velocity_actual"),
         period_us=PERIOD_US,
         samples=SAMPLES,
-        trigger=Trigger("target_velocity", "rising" if target > 0 else "falling", (base + target) / 2),
+        trigger=Trigger("target_velocity", "rising" if end > start else "falling", (start + end) / 2),
         pre_trigger_pct=PRE_TRIGGER_PCT,
         timeout_s=10.0,
     )
-    capture = _record(drive, definition, lambda: drive.write("target_velocity", target),
-                      lambda: drive.write("target_velocity", 0))  # fmt: skip
-    times = capture.times_s()
+    capture = _record(drive, definition, step, lambda: drive.write("target_velocity", 0))
     rpm = speed_rad_s(drive, 1.0) * RPM  # one user unit/s in rpm
     reference = [float(value) * rpm for value in capture.physical(0)]
-    response = [float(value) * rpm for value in capture.physical(1)]
-    metrics = step_metrics(times, reference, response, _measurement_filters(drive))
-    return {**metrics.as_dict(), "capture": _shown(times, reference, response, "rpm")}
+    return capture.times_s(), reference, [float(value) * rpm for value in capture.physical(1)]
 
 
 def _position_step(drive: Drive) -> dict[str, object]:
@@ -215,7 +269,9 @@ def _loop_speed_filter(drive: Drive) -> float | None:
     return 1.0 / (TWO_PI * tau) if tau else None
 
 
-def _shown(times: list[float], reference: list[float], response: list[float], unit: str) -> dict[str, object]:
+def _shown(
+    times: Sequence[float], reference: Sequence[float], response: Sequence[float], unit: str
+) -> dict[str, object]:
     return {
         "time_s": [round(value, 6) for value in times],
         "reference": [round(value, 3) for value in reference],

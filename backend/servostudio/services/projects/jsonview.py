@@ -9,7 +9,7 @@ from servostudio.services.projects.errors import ProjectError
 from servostudio.services.projects.motors import Motor
 from servostudio.services.projects.parameter_values import display
 from servostudio.services.projects.parameters import ParameterRow
-from servostudio.services.projects.service import AxisChoice
+from servostudio.services.projects.service import AxisChoice, ValueChange
 from servostudio.services.projects.store import ProjectStore, Snapshot
 from servostudio.services.projects.templates import ApplicationTemplate
 
@@ -63,6 +63,19 @@ def parameter_view(row: ParameterRow) -> dict:
         "file": row.file,
         "editable": row.editable_reason is None,
         "not_editable_reason": row.editable_reason,
+    }
+
+
+def value_change_view(change: ValueChange) -> dict:
+    """One project value a change replaces, old and new as the parameter rows show values."""
+    variable = change.variable
+    return {
+        "index": variable.index,
+        "subindex": variable.subindex,
+        "name": variable.label,
+        "unit": variable.unit,
+        "old": display(variable, change.old),
+        "new": display(variable, change.new),
     }
 
 

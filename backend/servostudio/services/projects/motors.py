@@ -171,11 +171,7 @@ class MotorCatalog:
         found: dict[str, Motor] = {}
         for directory, builtin in ((self.builtin_dir, True), (self.user_dir, False)):
             for path in _motor_files(directory):
-                motor = motor_from_text(path.read_text(encoding="utf-8"), path, builtin)
-                if motor.reference != path.stem:
-                    raise FileFormatError(
-                        path, 1, f"reference '{motor.reference}' must equal the file name '{path.stem}'"
-                    )
+                motor = _motor_file(path, builtin)
                 found.setdefault(motor.reference.casefold(), motor)
         return sorted(found.values(), key=lambda motor: motor.reference.casefold())
 
@@ -210,6 +206,16 @@ class MotorCatalog:
             raise ValidationError(f"motor '{motor.reference}' is built in and cannot be removed")
         assert self.user_dir is not None
         (self.user_dir / f"{motor.reference}.toml").unlink()
+
+
+def _motor_file(path: Path, builtin: bool) -> Motor:
+    """One catalog file; its errors name it by its place in the catalog (``built-in motors/M.toml``, ``user
+    motors/M.toml``), never by its server path."""
+    place = f"{'built-in' if builtin else 'user'} motors/{path.name}"
+    motor = motor_from_text(path.read_text(encoding="utf-8"), place, builtin)
+    if motor.reference != path.stem:
+        raise FileFormatError(place, 1, f"reference '{motor.reference}' must equal the file name '{path.stem}'")
+    return motor
 
 
 def _motor_files(directory: Path | None) -> list[Path]:

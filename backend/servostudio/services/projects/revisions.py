@@ -3,8 +3,8 @@ overwrote stays restorable.
 
 A change asks for it (:func:`keeping`); the project's files as they were before it are copied to
 ``<project>/.revisions/<seq>-<revision>/`` (a dot entry: never part of the revision hash, archives or copies),
-with ``about.json`` saying when and why. The newest :data:`KEEP` are kept. Restoring one (:func:`restore`) is itself
-a change that keeps the state it replaces, so it can be undone the same way. Saved oscilloscope captures are
+with ``about.json`` saying when, why and by whom. The newest :data:`KEEP` are kept. Restoring one (:func:`restore`)
+is itself a change that keeps the state it replaces, so it can be undone the same way. Saved oscilloscope captures are
 recordings, not settings: they are neither kept nor touched by a restore (as the revision hash leaves them out).
 """
 
@@ -18,6 +18,7 @@ from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
 
+from servostudio.services.audit import current_actor
 from servostudio.services.projects import layout
 from servostudio.services.projects.errors import ProjectNotFound
 from servostudio.services.projects.fsutil import atomic_write
@@ -36,6 +37,7 @@ class KeptRevision:
     saved_at: float  # epoch seconds: when the change that replaced it was made
     reason: str  # what replaced it ("backup of node 1 into the project", "restore of revision …")
     files: int
+    by: str = ""  # who made that change (the audit log's user; "" in revisions kept before it was recorded)
 
 
 def kept(directory: Path) -> list[KeptRevision]:
@@ -112,7 +114,13 @@ def _copy(directory: Path, revision: str, reason: str) -> Path:
         target.parent.mkdir(parents=True, exist_ok=True)
         shutil.copyfile(path, target)
         count += 1
-    about = {"revision": revision, "saved_at": time.time(), "reason": reason, "files": count}
+    about = {
+        "revision": revision,
+        "saved_at": time.time(),
+        "reason": reason,
+        "files": count,
+        "by": current_actor().user,
+    }
     atomic_write(snapshot / ABOUT, json.dumps(about))
     return snapshot
 
@@ -133,7 +141,8 @@ def _snapshots(directory: Path) -> list[Path]:
 
 def _about(path: Path) -> KeptRevision:
     about = json.loads((path / ABOUT).read_text(encoding="utf-8"))
-    return KeptRevision(str(about["revision"]), float(about["saved_at"]), str(about["reason"]), int(about["files"]))
+    fields = (str(about["revision"]), float(about["saved_at"]), str(about["reason"]), int(about["files"]))
+    return KeptRevision(*fields, by=str(about.get("by", "")))
 
 
 def _find(directory: Path, revision: str) -> Path:

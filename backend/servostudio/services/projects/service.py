@@ -7,16 +7,17 @@ from pathlib import Path
 
 from servostudio.formats.sequence import SequenceFileError, parse_sequence_text
 from servostudio.formats.textfile import FILE_ENCODING
+from servostudio.od import ObjectDictionary, Variable, parse_dictionary
 from servostudio.services.audit import AuditLog, ProjectAudit
-from servostudio.services.dictionaries import check_file
 from servostudio.services.projects import layout
 from servostudio.services.projects.archive import DEFAULT_LIMITS, ArchiveLimits, archive_project, unarchive_project
 from servostudio.services.projects.axisvalues import AxisValues
-from servostudio.services.projects.dcf import configured_values, export_dcf
+from servostudio.services.projects.dcf import ConfiguredValues, configured_values, export_dcf
 from servostudio.services.projects.errors import FileFormatError
 from servostudio.services.projects.model import Project
 from servostudio.services.projects.motors import BUILTIN_MOTORS_DIR, MotorCatalog
 from servostudio.services.projects.motorselect import apply_motor
+from servostudio.services.projects.parameter_values import Value
 from servostudio.services.projects.parameters import DictionaryLibrary, ParameterChange, ParameterService, parameter_row
 from servostudio.services.projects.revisions import KeptRevision, keeping, kept, restore
 from servostudio.services.projects.store import UNRECORDED, ProjectStore, Snapshot
@@ -25,11 +26,22 @@ from servostudio.services.projects.validation import validate_project
 
 
 @dataclass(frozen=True)
+class ValueChange:
+    """One project value a change replaces: the object, its value before and after."""
+
+    variable: Variable
+    old: Value | None
+    new: Value | None
+
+
+@dataclass(frozen=True)
 class DcfImport:
-    """Result of a DCF import: the objects set, and the configured values the project cannot hold (and why)."""
+    """Result of a DCF import (or of its preview): the objects set, the project values that change (old, new), and
+    the configured values the project cannot hold (and why)."""
 
     change: ParameterChange
     skipped: list[str]
+    changes: list[ValueChange]
 
 
 @dataclass(frozen=True)
@@ -91,18 +103,30 @@ class ProjectService:
             eds_text = values.dictionary.source.read_text(encoding="latin-1")
             return export_dcf(eds_text, view.project, chosen, values)
 
-    def import_dcf(self, project: str, axis: str, dcf: Path, expected_revision: str | None = None) -> DcfImport:
+    def import_dcf(
+        self, project: str, axis: str, text: str, file_name: str, expected_revision: str | None = None
+    ) -> DcfImport:
         """Set the axis's offline values to what a DCF configures (all or nothing, checked as offline edits); the
-        configured values the project cannot hold are listed in the result."""
-        configuration = check_file(dcf)
-        with self.store.edit(project, expected_revision) as edit:
+        configured values the project cannot hold are listed in the result, and the project as it was is kept as a
+        revision. The DCF comes as its text and the name the user knows it by, so its errors name that file and
+        never a server path."""
+        configuration = parse_dictionary(text, file_name)
+        kept = f"import of {Path(file_name).name} into axis {axis}"  # the values it replaces stay restorable
+        with self.store.edit(project, expected_revision) as edit, keeping(edit, kept):
             values = self.parameters.axis_values(edit, axis)
-            configured = configured_values(configuration, values)
-            for variable, value in configured.values:
-                values.stage(variable, value)
+            configured, changes = _configure(configuration, values)
             values.commit(edit, axis)
         rows = [parameter_row(values, variable) for variable, _ in configured.values]
-        return DcfImport(ParameterChange(rows, edit.revision), configured.skipped)
+        return DcfImport(ParameterChange(rows, edit.revision), configured.skipped, changes)
+
+    def preview_dcf(self, project: str, axis: str, text: str, file_name: str) -> DcfImport:
+        """What :meth:`import_dcf` would do, checked the same way, without writing: the confirmation shows it."""
+        configuration = parse_dictionary(text, file_name)
+        with self.store.read(project) as view:
+            values = self.parameters.axis_values(view, axis)
+            configured, changes = _configure(configuration, values)
+        rows = [parameter_row(values, variable) for variable, _ in configured.values]
+        return DcfImport(ParameterChange(rows, view.revision), configured.skipped, changes)
 
     def revisions(self, project: str) -> list[KeptRevision]:
         """The project's kept revisions, newest first (what changes that replaced many values overwrote)."""
@@ -134,3 +158,16 @@ class ProjectService:
                 except SequenceFileError as error:
                     first = error.issues[0]
                     raise FileFormatError(sequence, first.line, str(first).partition(": ")[2]) from None
+
+
+def _configure(configuration: ObjectDictionary, values: AxisValues) -> tuple[ConfiguredValues, list[ValueChange]]:
+    """Stage a DCF's configured values on the axis's values (each checked as an offline edit); return them and the
+    project values they change, old and new."""
+    configured = configured_values(configuration, values)
+    changes = []
+    for variable, value in configured.values:
+        old = values.value(variable)
+        values.stage(variable, value)
+        if values.value(variable) != old:
+            changes.append(ValueChange(variable, old, values.value(variable)))
+    return configured, changes

@@ -34,6 +34,7 @@ from servostudio.services.projects import layout
 from servostudio.services.projects.devices import axis_files
 from servostudio.services.projects.errors import (
     ConflictError,
+    FileFormatError,
     ProjectExists,
     ProjectNotFound,
     ValidationError,
@@ -316,7 +317,8 @@ class ProjectStore:
         with locked_directory(directory, exclusive) as locked:
             if not is_same_directory(locked, directory):
                 raise ProjectNotFound(f"project '{name}' was renamed or deleted meanwhile")
-            yield directory
+            with _named_in_project(directory):
+                yield directory
 
     @contextlib.contextmanager
     def staging(self, parent: Path | None = None) -> Iterator[Path]:
@@ -373,6 +375,20 @@ class ProjectStore:
         for existing in self.root.iterdir():
             if same_name(existing.name, name):
                 raise ProjectExists(f"'{existing.name}' already exists in the project store; choose another name")
+
+
+@contextlib.contextmanager
+def _named_in_project(directory: Path) -> Iterator[None]:
+    """A malformed file of the project is named by its place in the project (``demo/X/DRIVEPAR.TXT``), not by its
+    server path: the message goes to browsers and scripts, which know the project, not the server's disk."""
+    try:
+        yield
+    except FileFormatError as error:
+        path = Path(error.file)
+        if not path.is_relative_to(directory):
+            raise
+        place = Path(directory.name, path.relative_to(directory)).as_posix()
+        raise FileFormatError(place, error.line, error.reason) from None
 
 
 def _switch_device_files(directory: Path, axis: Axis, device: str) -> None:

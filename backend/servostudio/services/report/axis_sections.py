@@ -43,7 +43,7 @@ def _recorded_identity(record: AxisRecord) -> str:
         return absent("Firmware and serial number not recorded in the project: no saved capture of this axis names "
                       "the drive it came from.")  # fmt: skip
     rows = [(name, _hex(identity.get(key))) for key, name in IDENTITY_NUMBERS]
-    rows.append(("Firmware (software version)", shown(identity.get("software_version"))))
+    rows.append(("Firmware (software version)", shown(identity.get("software_version") or None)))
     rows.append(("Product name", shown(identity.get("product_name") or None)))
     return note(f"As the drive identified itself in the {record.identity_source}:") + facts(rows)
 
@@ -73,9 +73,9 @@ def motor(record: AxisRecord) -> str:
 def parameters(record: AxisRecord) -> str:
     if not record.differing:
         return absent("Every parameter saved in the drive files has its dictionary default.")
-    return note(f"{len(record.differing)} parameters differ from the dictionary defaults.") + _parameter_table(
-        record.differing
-    )
+    count = len(record.differing)
+    differ = "parameter differs" if count == 1 else "parameters differ"
+    return note(f"{count} {differ} from the dictionary defaults.") + _parameter_table(record.differing)
 
 
 def _parameter_table(rows: list[ParameterRow]) -> str:
@@ -128,8 +128,8 @@ def _state(response: dict[str, Any]) -> str:
 def audit(entries: list[dict[str, Any]], available: bool) -> str:
     """The audit log's changes: one row per second, user and change."""
     if not available:
-        return absent("No audit log at hand (it is the server's, not the project's): who changed the project's "
-                      "settings is not shown.")  # fmt: skip
+        return absent("No audit log at hand (it is the server's, not the project's, and reading it needs the Expert "
+                      "level): who changed the project's settings is not shown.")  # fmt: skip
     if not entries:
         return absent("The audit log records no change here.")
     changes = Counter((str(entry.get("time", ""))[:19], str(entry.get("user", "")), _what(entry)) for entry in entries)

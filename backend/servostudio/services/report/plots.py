@@ -63,6 +63,7 @@ def bode_plot(results: Sequence[Mapping[str, Any]], div_id: str) -> str | None:
     figure.update_xaxes(title_text="frequency [Hz]", row=3, col=1)
     for row, title in enumerate(("magnitude [dB]", "phase [°]", "coherence"), 1):
         figure.update_yaxes(title_text=title, showgrid=True, row=row, col=1)
+    figure.update_yaxes(range=[0, 1.05], row=3, col=1)  # coherence is 0..1 whatever the data
     return _div(figure, div_id)
 
 

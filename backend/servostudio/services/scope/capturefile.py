@@ -41,26 +41,37 @@ class CaptureFileError(InvalidInput):
 def capture_csv(capture: Capture) -> str:
     """The CSV text of a capture."""
     out = io.StringIO()
-    writer = csv.writer(out, lineterminator="\n")
-    for key, value in _comments(capture):
-        out.write(f"# {key}: {value}\n")
-    writer.writerow([TIME_COLUMN, *(channel.key for channel in capture.channels)])
+    writer = csv_head(out, _comments(capture), capture.channels)
     columns = [capture.physical(channel) for channel in range(len(capture.channels))]
     for sample in range(capture.samples):
-        writer.writerow([seconds_text(capture.time_ns(sample)), *(_value_text(column[sample]) for column in columns)])
+        writer.writerow([seconds_text(capture.time_ns(sample)), *(value_text(column[sample]) for column in columns)])
     return out.getvalue()
 
 
-def _comments(capture: Capture) -> list[tuple[str, str]]:
+def csv_head(out: io.StringIO, comments: list[tuple[str, str]], channels: tuple[ChannelInfo, ...]) -> Any:
+    """The comment lines and the header row, written; the writer of the data rows (the roll's CSV shares it)."""
+    writer = csv.writer(out, lineterminator="\n")
+    for key, value in comments:
+        out.write(f"# {key}: {value}\n")
+    writer.writerow([TIME_COLUMN, *(channel.key for channel in channels)])
+    return writer
+
+
+def units_text(channels: tuple[ChannelInfo, ...]) -> str:
+    """The ``units`` comment: a CSV row aligned with the header (``s`` for the time)."""
     units = io.StringIO()
-    csv.writer(units, lineterminator="").writerow(["s", *(channel.unit for channel in capture.channels)])
+    csv.writer(units, lineterminator="").writerow(["s", *(channel.unit for channel in channels)])
+    return units.getvalue()
+
+
+def _comments(capture: Capture) -> list[tuple[str, str]]:
     definition = capture.definition
     return [
         ("period", f"{microseconds_text(capture.period_ns)} us"),
         ("samples", str(capture.samples)),
         ("trigger", capture.trigger),
         ("pre-trigger", f"{definition.pre_trigger_pct:g} % ({capture.trigger_index} samples)"),
-        ("units", units.getvalue()),
+        ("units", units_text(capture.channels)),
         ("drive", capture.drive.describe()),
         ("node", str(capture.drive.node)),
         ("bus", capture.drive.bus),
@@ -99,7 +110,7 @@ def microseconds_text(nanoseconds: int) -> str:
     return fixed_point_text(nanoseconds, 3)
 
 
-def _value_text(value: Number) -> str:
+def value_text(value: Number) -> str:
     return str(value) if isinstance(value, int) else repr(value)
 
 

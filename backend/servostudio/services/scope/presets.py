@@ -22,60 +22,32 @@ class Preset:
     definition: CaptureDefinition
 
 
-PRESETS: tuple[Preset, ...] = (
-    Preset(
-        "speed-step",
-        "Speed step",
-        "Target velocity, velocity, current and status word around a step of the target velocity (profile "
-        "velocity mode): rise time, overshoot and settling of the speed loop.",
-        CaptureDefinition(
-            channels=("0x60FF,0", "0x606C,0", "0x6078,0", "0x6041,0"),
-            period_us=250,
-            samples=2048,
-            trigger=Trigger("0x60FF,0", "either", 1),
-            pre_trigger_pct=20,
-        ),
-    ),
-    Preset(
-        "following-error",
-        "Following error",
-        "Position demand, actual position, following error and velocity over a move, from its start: the "
-        "following-error threshold and the position loop.",
-        CaptureDefinition(
-            channels=("0x6062,0", "0x6064,0", "0x60F4,0", "0x606C,0"),
-            period_us=1000,
-            samples=2048,
-            trigger=Trigger("0x606B,0", "either", 1),
-            pre_trigger_pct=10,
-        ),
-    ),
-    Preset(
-        "current-loop",
-        "Current loop",
-        "Target torque, torque demand, torque and current at the control rate around a torque step: the current "
-        "loop's response and noise.",
-        CaptureDefinition(
-            channels=("0x6071,0", "0x6074,0", "0x6077,0", "0x6078,0"),
-            period_us=250,
-            samples=2048,
-            trigger=Trigger("0x6071,0", "either", 1),
-            pre_trigger_pct=10,
-        ),
-    ),
-    Preset(
-        "io-timing",
-        "I/O timing",
-        "Digital inputs and outputs, status word and velocity around the first input that switches on: the "
-        "delay between an input and the drive's answer.",
-        CaptureDefinition(
-            channels=("0x60FD,0", "0x60FE,1", "0x6041,0", "0x606C,0"),
-            period_us=250,
-            samples=2048,
-            trigger=Trigger("0x60FD,0", "rising", 1),
-            pre_trigger_pct=50,
-        ),
-    ),
-)
+#: key, title, what it shows; channels; period in µs; trigger source and edge (level 1); pre-trigger in %
+_TABLE = (
+    ("speed-step", "Speed step",
+     "Target velocity, velocity, current and status word around a step of the target velocity (profile velocity "
+     "mode): rise time, overshoot and settling of the speed loop.",
+     ("0x60FF,0", "0x606C,0", "0x6078,0", "0x6041,0"), 250, ("0x60FF,0", "either"), 20),
+    ("following-error", "Following error",
+     "Position demand, actual position, following error and velocity over a move, from its start: the "
+     "following-error threshold and the position loop.",
+     ("0x6062,0", "0x6064,0", "0x60F4,0", "0x606C,0"), 1000, ("0x606B,0", "either"), 10),
+    ("current-loop", "Current loop",
+     "Target torque, torque demand, torque and current at the control rate around a torque step: the current "
+     "loop's response and noise.",
+     ("0x6071,0", "0x6074,0", "0x6077,0", "0x6078,0"), 250, ("0x6071,0", "either"), 10),
+    ("io-timing", "I/O timing",
+     "Digital inputs and outputs, status word and velocity around the first input that switches on: the delay "
+     "between an input and the drive's answer.",
+     ("0x60FD,0", "0x60FE,1", "0x6041,0", "0x606C,0"), 250, ("0x60FD,0", "rising"), 50),
+)  # fmt: skip
+
+PRESETS: tuple[Preset, ...] = tuple(
+    Preset(key, title, description, CaptureDefinition(
+        channels=channels, period_us=period_us, samples=2048, trigger=Trigger(source, edge, 1), pre_trigger_pct=pre,
+    ))
+    for key, title, description, channels, period_us, (source, edge), pre in _TABLE
+)  # fmt: skip
 
 
 class UnknownPreset(NotFound):

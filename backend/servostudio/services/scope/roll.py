@@ -61,13 +61,22 @@ def roll_plan(drive: Drive, axes: Callable[[int], Drive], definition: CaptureDef
 
 class RollFeed:
     """The roll's events for its readers, each with its own cursor; a reader too slow for ``keep`` events is told
-    what it missed (a gap), never given a silent hole."""
+    what it missed (a gap), never given a silent hole. An endless roll (no ``seconds``) is there for its readers:
+    when the last one leaves (a closed tab, a lost network), ``join`` says so and the roll is stopped."""
 
-    def __init__(self, keep: int = FEED_EVENTS) -> None:
+    def __init__(self, keep: int = FEED_EVENTS, endless: bool = False) -> None:
         self._events: deque[Event] = deque(maxlen=keep)
         self._count = 0
         self._lock = Lock()
         self.ended = False
+        self.endless = endless
+        self._readers = 0
+
+    def join(self, delta: int) -> bool:
+        """A reader came (+1) or left (−1); True when an endless roll has none left."""
+        with self._lock:
+            self._readers += delta
+            return self.endless and self._readers == 0 and not self.ended
 
     def put(self, event: Event) -> None:
         with self._lock:
@@ -180,7 +189,9 @@ class RollStream(TpdoStream):
         for receiver in self.receivers:
             del receiver.frames[:complete]
         self.taken += complete
-        instants = run.sync.sent  # an answer may arrive before its SYNC's send instant is noted: the latest then
+        # an answer may arrive before its SYNC's send instant is noted (the latest instant then), and after a cut link
+        # late answers of the previous run before the new producer noted any instant (now, then)
+        instants = run.sync.sent or [time.monotonic()]
         last = len(instants) - 1
         sent = instants[min(run.delivered, last)], instants[min(run.delivered + complete - 1, last)]
         self.feed(self._batch(run.base + run.delivered, samples, sent))

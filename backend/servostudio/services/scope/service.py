@@ -18,7 +18,7 @@ import threading
 import time
 from collections import OrderedDict
 from collections.abc import Callable
-from dataclasses import replace
+from dataclasses import asdict, replace
 from datetime import UTC, datetime
 
 from servostudio.drive.access import Drive
@@ -33,6 +33,7 @@ from servostudio.services.scope.plan import CapturePlan, CaptureRefused, plan_ca
 from servostudio.services.scope.presets import presets_for
 from servostudio.services.scope.recorder import POLL_SECONDS, RecorderSession, Report
 from servostudio.services.scope.roll import RollFeed, RollStream, roll_plan
+from servostudio.services.scope.rollfile import RollRecord
 from servostudio.services.scope.stream import PollStream, StreamResult, TpdoStream
 from servostudio.services.scope.stream_plan import Axes, Bus, StreamPlan, plan_stream
 
@@ -138,6 +139,21 @@ def stream_once(drive: Drive, plan: StreamPlan, identity: DriveIdentity, report:
     return streamed_capture(plan, result, identity)
 
 
+def roll(drive: Drive, identity: DriveIdentity, definition: CaptureDefinition, seconds: float,
+         cancellation: Cancellation, axes: Axes | None = None, bitrate: int | None = None) -> RollRecord:  # fmt: skip
+    """A roll of ``seconds`` (or until cancelled), start to end, every sample and gap kept (the CLI's ``--roll``);
+    refused (``CaptureRefused``) before anything is written when the bus cannot carry it."""
+    plan = roll_plan(drive, axes or _alone(drive), definition, bitrate, seconds)
+    channels = tuple(replace(ChannelInfo.of(channel.variable), key=channel.key) for channel in plan.channels)
+    record = RollRecord(channels, plan.period_ns, identity, _now())
+    RollStream(plan, _reach(drive, plan, axes), drive.engine.link, record.take, seconds).run(_quiet, cancellation)
+    return record
+
+
+def _now() -> str:
+    return datetime.now(UTC).isoformat(timespec="seconds").replace("+00:00", "Z")
+
+
 def _reach(drive: Drive, plan: StreamPlan, axes: Axes | None) -> Axes:
     """Each node of the plan's drive (the capture's own node is ``drive``)."""
     reach = axes or _alone(drive)
@@ -156,7 +172,7 @@ def streamed_capture(plan: StreamPlan, result: StreamResult, identity: DriveIden
         trigger=type(trigger)(source, trigger.edge, trigger.level).describe(variable.unit if variable else ""),
         columns=result.columns,
         drive=identity,
-        captured_at=datetime.now(UTC).isoformat(timespec="seconds").replace("+00:00", "Z"),
+        captured_at=_now(),
         source=plan.source,
         alignment_ns=result.alignment_ns,
     )
@@ -173,6 +189,7 @@ class ScopeService:
         self.keep = keep
         self._captures: OrderedDict[str, Capture] = OrderedDict()
         self._running: dict[Node, Job] = {}
+        self._sync: dict[str, Job] = {}  # the job producing each bus's SYNC (TPDO captures and rolls)
         self._feeds: OrderedDict[str, RollFeed] = OrderedDict()
         self._numbers = itertools.count(1)
         self._lock = threading.Lock()
@@ -224,18 +241,27 @@ class ScopeService:
             return self._run(drive, plan, identity, _on_node(progress, node), cancellation, connection.drive)
 
         nodes = plan.nodes if isinstance(plan, StreamPlan) else (drive.node,)
-        return self._claim(connection.id, nodes, lambda: jobs.start("scope", work))
+        sync = isinstance(plan, StreamPlan) and plan.source == "tpdo"
+        return self._claim(connection.id, nodes, lambda: jobs.start("scope", work), sync)
 
-    def _claim(self, bus: str, nodes: tuple[int, ...], start: Callable[[], Job]) -> Job:
-        """Start a job that holds ``nodes`` (none of which may run a capture or a roll already)."""
+    def _claim(self, bus: str, nodes: tuple[int, ...], start: Callable[[], Job], sync: bool = False) -> Job:
+        """Start a job that holds ``nodes`` (none of which may run a capture or a roll already) and, through TPDOs,
+        the bus's SYNC: a second SYNC producer would make every drive answer both, each capture's samples then
+        no longer one per period."""
         held = [(bus, other) for other in nodes]
         with self._lock:
             for other in held:
                 running = self._running.get(other)
                 if running is not None and running.state == "running":
                     raise CaptureRunning(f"node {other[1]}: capture {running.id} is running; stop it first")
+            producer = self._sync.get(bus)
+            if sync and producer is not None and producer.state == "running":
+                raise CaptureRunning(f"bus {bus}: capture {producer.id} sends the SYNC its TPDOs answer (one SYNC "
+                                     "producer per bus); stop it first, or capture these channels with it")  # fmt: skip
             job = start()
             self._running.update(dict.fromkeys(held, job))
+            if sync:
+                self._sync[bus] = job
         return job
 
     def start_roll(self, jobs: JobRegistry, connection: BusConnection, drive: Drive, definition: CaptureDefinition,
@@ -243,7 +269,7 @@ class ScopeService:
         """Check the roll (its bus budget above all: refused before anything is armed), then roll in a job whose
         samples the feed of the job's id serves (``feed``); recorded, the samples become a capture at the end."""
         plan = roll_plan(drive, connection.drive, definition, connection.spec.bitrate, seconds)
-        identity, feed = identity_of(connection, drive), RollFeed()
+        identity, feed = identity_of(connection, drive), RollFeed(endless=seconds is None)
         node = (connection.id, drive.node)
 
         def work(progress: Callable[[dict[str, object]], None], cancellation: Cancellation) -> object:
@@ -251,7 +277,7 @@ class ScopeService:
                                 record)  # fmt: skip
             return self._roll(stream, identity, _on_node(progress, node), cancellation, feed)
 
-        job = self._claim(connection.id, plan.nodes, lambda: jobs.start("scope-roll", work))
+        job = self._claim(connection.id, plan.nodes, lambda: jobs.start("scope-roll", work), sync=True)
         with self._lock:
             self._feeds[job.id] = feed
             while len(self._feeds) > KEEP_FEEDS:
@@ -265,7 +291,8 @@ class ScopeService:
         except Exception as error:
             feed.put({"type": "end", "error": str(error)})
             raise
-        summary: dict[str, object] = {**stream.summary(), "bus": identity.bus, "node": identity.node}
+        summary: dict[str, object] = {**stream.summary(), "bus": identity.bus, "node": identity.node,
+                                      "drive": asdict(identity)}  # fmt: skip
         if result.columns:
             summary["capture"] = self.remember(streamed_capture(stream.plan, result, identity))
         feed.put({"type": "end", **summary})

@@ -35,6 +35,10 @@ from servostudio.services.scope.window import Sample, SampleWindow
 TAKE_SECONDS = 0.01
 #: how long a first SYNC waits for the TPDOs of OPERATIONAL nodes
 PROBE_SECONDS = 0.1
+#: after the probe, how long no frame may come before the capture's SYNCs start (a late answer to the probe would
+#: otherwise be taken for sample 0), and how many such waits at most
+QUIET_SECONDS = 0.05
+QUIET_TRIES = 20
 Columns = tuple[tuple[int | float, ...], ...]
 
 
@@ -58,7 +62,10 @@ class _Receiver:
     frames: list[bytes] = field(default_factory=list)
 
     def on_frame(self, cob_id: int, data: bytes, timestamp: float) -> None:
-        self.frames.append(bytes(data))
+        """A frame of another length is the TPDO's former mapping, sent before the new one took effect (an event
+        TPDO of the status word while the drive was enabled): not a sample."""
+        if len(data) == self.layout.size:
+            self.frames.append(bytes(data))
 
 
 class TpdoStream:
@@ -108,8 +115,20 @@ class TpdoStream:
             send_nmt(self.link, NmtCommand.START, node)
             self.started.append(node)
         time.sleep(PROBE_SECONDS if silent else 0)
-        for receiver in self.receivers:
-            receiver.frames.clear()
+        self._settle()
+
+    def _settle(self) -> None:
+        """Drop the answers to the probe until none comes for ``QUIET_SECONDS``: no SYNC is sent meanwhile, so every
+        frame is a late answer, and one left in would be sample 0 of its TPDO — every sample of it one SYNC early.
+        A node thought silent whose answer came late was OPERATIONAL: it is not put back to PRE-OPERATIONAL after."""
+        for attempt in range(QUIET_TRIES):
+            late = {receiver.use.node for receiver in self.receivers if receiver.frames}
+            self.started = [node for node in self.started if node not in late]
+            for receiver in self.receivers:
+                receiver.frames.clear()
+            if attempt > 0 and not late:
+                return
+            time.sleep(QUIET_SECONDS)
 
     def _capture(self, report: Report, cancellation: Cancellation) -> StreamResult:
         plan = self.plan

@@ -20,6 +20,7 @@ import time
 from dataclasses import dataclass, field
 
 from servostudio.drive.access import Drive
+from servostudio.drive.nmt import NMT_STATES
 from servostudio.drive.sdo import SdoError
 from servostudio.formats.sequence import SequenceTable
 from servostudio.services.bus import BusConnection
@@ -112,7 +113,7 @@ class SequenceMonitor:
         """Map the TPDO, listen to it, put the node in OPERATIONAL (PDOs need it) and start polling."""
         self._cob_id = self._map_tpdo()
         self.connection.link.subscribe(self._cob_id, self._on_tpdo)
-        if self.connection.nmt_state(self.drive.node) != "operational":
+        if self.connection.nmt_state(self.drive.node) != NMT_STATES[0x05]:  # "OPERATIONAL", as heartbeats say
             self.connection.nmt("start", self.drive.node)
         self._poll_once()
         self._thread.start()

@@ -47,6 +47,7 @@ from servostudio.sim.drive.modes import (
     ProfileTorque,
     ProfileVelocity,
 )
+from servostudio.sim.drive.outputs import LogicOutputs
 from servostudio.sim.drive.physics import OVERCURRENT_FACTOR, TWO_PI, AxisPhysics
 from servostudio.sim.drive.procedures import ABORTED, FAILED
 from servostudio.sim.drive.protection import I2tProtection
@@ -76,6 +77,8 @@ PARAMETER_REFRESH_PERIODS = 128
 SUPERVISION_PERIODS = 4
 SLOW_PUBLISH_PERIODS = 32
 STANDSTILL_SPEED = 0.5  # rad/s: a stop has ended below this speed
+#: 0x60FD: the input functions (bits 0–15: limit switches, home, INHIBIT, …) and the INHIBIT bit
+INPUT_FUNCTIONS, INPUT_INHIBIT = 0xFFFF, 1 << 3
 DEFAULT_DRIVE_RATED_CURRENT = 5.0
 """A, the smallest drive rating the simulated drives have (a larger motor gets a drive rated for its stall current)."""
 UNDERVOLTAGE_DEFAULTS = {400: 210, 230: 100, 48: 30, 34: 20, 17: 17}
@@ -132,6 +135,9 @@ class DriveBehaviour:
         self.temperature_warning = False
         self.inhibit_active = False
         self.negative_limit = self.positive_limit = self.home_switch = False
+        #: 0x60FD function bits (0–15) the logic inputs give through their configuration (``sequencer/inputs.py``)
+        self.routed_inputs = 0
+        self._routed_inhibit = False
         self.position_offset_user = 0.0
         self.phasing_valid = plant.feedback != FEEDBACK_ENCODER  # an incremental encoder needs 'mcal' first
         self.max_speed = 1.0
@@ -165,6 +171,7 @@ class DriveBehaviour:
         self._register_hooks()
         self.procedures = ProcedureRunner(self)
         self.recorder = Recorder.for_store(store)
+        self.outputs = LogicOutputs(store)
         self.sequencer = SequenceMode.for_drive(self)
         if self.sequencer is not None:
             self.handlers[MODE_SQ] = self.sequencer
@@ -649,16 +656,30 @@ class DriveBehaviour:
     # -- inputs and protections ---------------------------------------------------------------------------------
 
     def _read_inputs(self) -> None:
-        physics = self.physics
-        self.negative_limit = physics.negative_limit_active()
-        self.positive_limit = physics.positive_limit_active()
-        self.home_switch = physics.home_switch_active()
-        inputs = (self.negative_limit and 1) | (self.positive_limit and 2) | (self.home_switch and 4)
-        if inputs != self._published_inputs:
-            self._published_inputs = inputs
+        """The input functions of 0x60FD (bits 0–15) and what the drive does on them: a limit switch blocks its
+        direction, INHIBIT disables, the others only show (homing reads the plant's switches; docs/io.md)."""
+        word, owned = self.input_word()
+        self.negative_limit, self.positive_limit, self.home_switch = bool(word & 1), bool(word & 2), bool(word & 4)
+        inhibit = bool(word & INPUT_INHIBIT)
+        if inhibit != self._routed_inhibit:
+            self._routed_inhibit = inhibit
+            self.set_inhibit(inhibit)
+        if word != self._published_inputs:
+            self._published_inputs = word
             if self.has("digital_inputs"):
-                current = int(self.p.get("digital_inputs", 0)) & ~0x7
-                self.write("digital_inputs", current | inputs)
+                current = int(self.p.get("digital_inputs", 0)) & ~owned
+                self.write("digital_inputs", current | word)
+
+    def input_word(self) -> tuple[int, int]:
+        """(the bits of 0x60FD this model sets, their mask): the plant's own limit and home switches, which act on
+        the drive's functions directly, and the functions the logic-input routing gives (``routed_inputs``)."""
+        physics = self.physics
+        plant = (
+            (physics.negative_limit_active() and 1)
+            | (physics.positive_limit_active() and 2)
+            | (physics.home_switch_active() and 4)
+        )
+        return plant | self.routed_inputs, INPUT_FUNCTIONS
 
     def _protect(self) -> None:
         physics = self.physics
@@ -890,9 +911,20 @@ class DriveBehaviour:
         if warnings != self.warnings:
             self.warnings = warnings
             self.write("warning_word", warnings)
-        if self.has("digital_outputs") and not int(self.p.get("digital_output_mask", 0)) & 1:
-            outputs = int(self.p.get("digital_outputs", 0)) & ~1
-            self.write("digital_outputs", outputs | (0 if self.device_control.brake_released else 1))
+        if self.has("digital_outputs"):
+            self._publish_outputs()
+
+    def _publish_outputs(self) -> None:
+        """0x60FE,1: the outputs the sources 0x3054 drive (``outputs.py``), the bus's others, and bit 0 the brake
+        unless the bit mask 0x60FE,2 gives it to the bus."""
+        current = int(self.p.get("digital_outputs", 0))
+        bits, mask = self.outputs.routed()
+        outputs = current & ~mask | bits
+        if not int(self.p.get("digital_output_mask", 0)) & 1:
+            outputs = outputs & ~1 | (0 if self.device_control.brake_released else 1)
+        self.write("digital_outputs", outputs)
+        if mask:
+            self.outputs.show(outputs)
 
     def _warnings(self) -> int:
         warnings = 0

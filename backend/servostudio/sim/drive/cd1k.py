@@ -14,6 +14,9 @@ The scalings of the gains are the project's (docs/control-loops.md), as for the 
 
 from __future__ import annotations
 
+from typing import Any
+
+from servostudio.od.model import Value
 from servostudio.sim.drive import errors
 from servostudio.sim.drive.behaviour import DriveBehaviour
 from servostudio.sim.drive.device_map import _COMMON_402, IDENTIFIED_PLANT, DeviceProfile
@@ -64,6 +67,8 @@ CD1K = DeviceProfile(
         "brake_reaction_time": (0x3305, 0),
         "tuning_bandwidth": (0x3420, 1),
         "tuning_requirement": (0x3430, 0),
+        "input_mask": (0x30FD, 0),
+        "sim_physical_inputs": (0x5F00, 0),
         **IDENTIFIED_PLANT,
     },
     modes=frozenset({1, 3, 4, 6, 7}),
@@ -93,7 +98,35 @@ _ERROR_BITS = {
 _PHASE_ORDER = {1: 0, -1: 1}
 
 
+#: 0x30FD / 0x60FD bits 16–21 / 0x5F00: INPUT0 (LS+), INPUT1 (LS−), INHIBIT, INDEX, CAPTURE, LOW SPEED
+LS_PLUS, LS_MINUS, INHIBIT = 1 << 0, 1 << 1, 1 << 2
+PHYSICAL_SHIFT, PHYSICAL_INPUTS = 16, 0x3F
+WIRING = (0x5F00, 0)
+#: the input functions of 0x60FD a dedicated input gives: LS+ → bit 1 (positive limit), LS− → bit 0, INHIBIT → bit 3
+_DEDICATED = ((LS_PLUS, 1 << 1), (LS_MINUS, 1 << 0), (INHIBIT, 1 << 3))
+
+
 class Cd1kBehaviour(DriveBehaviour):
+    def __init__(self, *args: Any, **kwargs: Any) -> None:
+        super().__init__(*args, **kwargs)
+        if WIRING in self.store:
+            self.store.on_write(*WIRING, self._wired)
+
+    def _wired(self, index: int, sub: int, value: Value) -> None:
+        """The test bench's wiring is hardware: it is kept through a warm reset."""
+        self.store.set_factory(index, sub, value)
+
+    def input_word(self) -> tuple[int, int]:
+        """The CD1-k's six inputs (docs/io.md): the plant's limit switches are wired to LS+ and LS−, the test bench
+        (0x5F00, 1 = active) may activate any input.  An input keeps its function only where 0x30FD has its bit
+        (1 = dedicated, the factory 0x3F); a freed input shows in 0x60FD bits 16–21 and does nothing else."""
+        physics = self.physics
+        levels = int(self.p.get("sim_physical_inputs", 0)) & PHYSICAL_INPUTS
+        levels |= (physics.positive_limit_active() and LS_PLUS) | (physics.negative_limit_active() and LS_MINUS)
+        dedicated = levels & int(self.p.get("input_mask", PHYSICAL_INPUTS))
+        functions = (physics.home_switch_active() and 1 << 2) | sum(bit for line, bit in _DEDICATED if dedicated & line)
+        return functions | levels << PHYSICAL_SHIFT, 0xFFFF | PHYSICAL_INPUTS << PHYSICAL_SHIFT
+
     def read_units(self) -> UnitScaling:
         increments = float(self.p.get("encoder_increments", 0)) or float(self.physics.counts_per_turn)
         return UnitScaling(increments)

@@ -54,8 +54,12 @@ class EncoTriveBehaviour(DriveBehaviour):
             self.store.on_write(address[0], address[1], self._preset_position)
 
     def set_hardware_data(self) -> None:
-        """The manual's ramps and speed limits where the dictionary leaves them open, then the common values."""
-        for (index, sub), value in FACTORY_VALUES.items():
+        """The manual's ramps and speed limits where the dictionary leaves them open, the integrated motor's rating
+        (6075h mA, 6076h mN·m: the factory knows its motor), then the common values."""
+        plant = self.plant
+        torque = plant.torque_constant * plant.stall_current
+        rating = {(0x6075, 0): round(plant.stall_current * 1000), (0x6076, 0): round(torque * 1000)}
+        for (index, sub), value in (FACTORY_VALUES | rating).items():
             if (index, sub) in self.store and self.store.od[index, sub].default_for(self.store.node_id) is None:
                 self.store.set_factory(index, sub, value)
         super().set_hardware_data()

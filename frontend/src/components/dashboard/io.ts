@@ -1,7 +1,11 @@
-/** Digital I/O (0x60FD inputs, 0x60FE,1 outputs) as LEDs named by their bit fields. */
+/**
+ * Digital I/O (0x60FD inputs, 0x60FE,1 outputs) as LEDs named by their bit fields, or by the names the I/O
+ * configuration gives them (the input and its function: `lib/io-names.ts`) once those are known.
+ */
 
 import { extractBits, fieldLabel } from "../../lib/bits";
 import { h } from "../../lib/dom";
+import type { IoNames } from "../../lib/io-names";
 import type { Entry } from "../../lib/od";
 
 export interface DigitalIoProps {
@@ -10,6 +14,8 @@ export interface DigitalIoProps {
   /** The live word of an entry (null until it arrived); read inside bindings. */
   word(entry: Entry): number | null;
   address(entry: Entry): string;
+  /** The I/O configuration's names (null until read, or when the device has none); read inside bindings. */
+  names?(): IoNames | null;
 }
 
 export function digitalIo(props: DigitalIoProps): HTMLElement {
@@ -27,13 +33,26 @@ function ioGroup(title: string, entry: Entry, props: DigitalIoProps): HTMLElemen
       const value = word();
       return value === null ? "" : ` = 0x${value.toString(16).toUpperCase().padStart(8, "0")}`;
     }),
-    h("div", { class: "io-row", "data-testid": `io-${title.toLowerCase()}` }, entry.variable.bits.map((field) => h("span", {
-      class: () => {
-        const value = word();
-        return `led ${value !== null && extractBits(value, field.first, field.last) !== 0 ? "on" : ""}`;
-      },
-      title: `bit ${fieldLabel(field)}: ${field.name}`,
-    }, shortName(field.name)))));
+    h("div", { class: "io-row", "data-testid": `io-${title.toLowerCase()}` }, entry.variable.bits.map((field) => {
+      const named = () => (title === "Inputs" ? props.names?.()?.inputs : props.names?.()?.outputs)?.get(field.first) ?? null;
+      return h("span", {
+        class: () => {
+          const value = word();
+          return `led ${value !== null && extractBits(value, field.first, field.last) !== 0 ? "on" : ""}`;
+        },
+        title: () => `bit ${fieldLabel(field)}: ${named() ?? field.name}`,
+      }, () => {
+        const label = named();
+        return label ? configuredName(label) : shortName(field.name);
+      });
+    })));
+}
+
+/** An LED label from the I/O configuration's "IN3: Positive limit switch" → "IN3 LIM+", "INPUT0 / LS+" → "INPUT0". */
+export function configuredName(label: string): string {
+  const [line, function_] = label.split(": ");
+  const name = line.split(" ")[0];
+  return function_ ? `${name} ${shortName(function_)}` : name;
 }
 
 /** A short LED label from a bit name: "IN1", "Negative limit switch" → "LIM−", "Home switch" → "Home". */

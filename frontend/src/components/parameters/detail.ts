@@ -1,12 +1,12 @@
 /**
  * The detail pane of the selected entry: description, drive and project value, the editor (see `write.ts`), bit
- * fields, enumeration, pointer target and the dictionary's facts. It is built once per selected entry; values
+ * fields, enumeration, pointer target and the dictionary's facts (the level needed to write it among them). It is built once per selected entry; values
  * that arrive later, and the editor's writability, are bound, so what the user typed stays where it is.
  */
 
 import { bitFields, enumList, pointerTarget, type ValueEditor } from "../editors";
 import { derive, h, untrack, type State } from "../../lib/dom";
-import { address, isWritable, type Entry, type Scalar } from "../../lib/od";
+import { address, isWritable, type Entry, type OdVariable, type Scalar } from "../../lib/od";
 import { formatRange, formatValue } from "../../lib/values";
 import { entryGroup } from "./rows";
 import { writeSection, type WriteContext } from "./write";
@@ -92,10 +92,18 @@ function facts(entry: Entry): HTMLElement {
     kv("Default", variable.default === null ? "none" : `${formatValue(variable, variable.default)} ${variable.unit}`.trim()),
     variable.scale !== 1 || variable.offset !== 0
       ? kv("Scaling", `physical = raw × ${variable.scale}${variable.offset ? ` + ${variable.offset}` : ""}`) : null,
+    kv("Write level", h("span", { "data-testid": "detail-write-level", title: "the lowest user level that may write it to a drive (docs/security.md)" },
+      writeLevelText(variable.write_level))),
     kv("Saved in", variable.save_type === "NONE" ? "not saved" : `${variable.save_type}.TXT`),
     kv("Group", entryGroup(entry) || "—"),
     variable.reference ? kv("Manual", variable.reference) : null,
   ));
+}
+
+/** The user level needed to write the entry, as the server's dictionary says (null: nobody writes it). */
+export function writeLevelText(level: OdVariable["write_level"]): string {
+  if (level === null) return "read-only";
+  return `${level.charAt(0).toUpperCase()}${level.slice(1)} or higher`;
 }
 
 function rawSuffix(entry: Entry, raw: Scalar): string {

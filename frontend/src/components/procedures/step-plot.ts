@@ -1,6 +1,6 @@
 /**
  * The verification step of an auto-tuning, recorded by the drive: reference and response over time drawn with
- * plotly.js (loaded on first use, as on the scope), with its rise time, overshoot and settling time beside it.
+ * plotly.js (loaded on first use, as on the scope), with its rise time, overshoot, settling time and bandwidth beside it.
  */
 
 import type { StepMeasure } from "../../client/procedures";
@@ -40,9 +40,16 @@ export function stepFigures(step: StepMeasure): [string, string, string][] {
   return [
     ["rise", "Rise time (10–90 %)", sig(step.rise_time_s === null ? null : step.rise_time_s * 1000, "ms")],
     ["overshoot", "Overshoot", sig(step.overshoot_pct, "%")],
-    ["settling", "Settling time (2 %)", sig(step.settling_time_s === null ? null : step.settling_time_s * 1000, "ms")],
-    ["bandwidth", "−3 dB bandwidth", sig(step.bandwidth_hz, "Hz")],
+    ["settling", "Settling time (5 %)", sig(step.settling_time_s === null ? null : step.settling_time_s * 1000, "ms")],
+    ["bandwidth", bandwidthLabel(step), sig(step.bandwidth_hz, "Hz")],
   ];
+}
+
+/** Measured from one step, or from the mean frequency response of the repeated speed steps that settled. */
+function bandwidthLabel(step: StepMeasure): string {
+  const steps = step.bandwidth_steps_hz ?? [];
+  const settled = steps.filter((value) => value !== null).length;
+  return steps.length > 1 ? `−3 dB bandwidth (${settled} of ${steps.length} steps)` : "−3 dB bandwidth";
 }
 
 export function stepView(step: StepMeasure, title: string, testid: string): HTMLElement {

@@ -7,7 +7,7 @@
  * cursors as vertical lines. FFT view: the magnitude spectrum (Hann window) of each channel on its own y-axis.
  */
 
-import type { CaptureData } from "../../client/scope";
+import type { CaptureChannel, CaptureData } from "../../client/scope";
 import { spectrum } from "../../lib/fft";
 import { derivative, difference, scaled } from "../../lib/measure";
 import type { Cursors, MathTrace } from "./model";
@@ -61,7 +61,7 @@ export function timeFigure(capture: CaptureData, math: MathTrace, cursors: Curso
   const data = capture.channels.map((_, n) => trace(label(capture, n), x, valuesOf(capture, n), n));
   const extra = mathValues(capture, math);
   if (extra) data.push({ ...trace(extra.name, x, extra.y, math.a), line: { color: COLORS[4], width: 1.5, dash: "dot" } });
-  const layout = axesLayout(capture, "time [s] (0 = trigger)");
+  const layout = axesLayout(capture.channels, "time [s] (0 = trigger)", capture.captured_at);
   layout.shapes = [preTriggerShade(x), marker(0, "#888", "dash"), ...cursorLines(cursors)];
   layout.annotations = [
     { x: 0, y: 1, yref: "paper", text: "T", showarrow: false, yanchor: "bottom", font: { color: "#888" } },
@@ -76,25 +76,26 @@ export function fftFigure(capture: CaptureData): Figure {
     const result = spectrum(valuesOf(capture, n).map((value) => (Number.isNaN(value) ? 0 : value)), dt);
     return trace(`|FFT| ${label(capture, n)}`, result.frequency, result.magnitude, n);
   });
-  return { data, layout: axesLayout(capture, "frequency [Hz] (Hann window)") };
+  return { data, layout: axesLayout(capture.channels, "frequency [Hz] (Hann window)", capture.captured_at) };
 }
 
-function trace(name: string, x: number[], y: number[], axis: number): Trace {
+export function trace(name: string, x: number[], y: number[], axis: number): Trace {
   return { type: "scattergl", mode: "lines", name, x, y, yaxis: axis === 0 ? "y" : `y${axis + 1}`, line: { color: COLORS[axis % 4], width: 1.5 } };
 }
 
-/** The x-axis and one y-axis per channel: the first on the left, the others stacked on the right. */
-function axesLayout(capture: CaptureData, xTitle: string): Record<string, unknown> {
-  const extra = Math.max(0, capture.channels.length - 1);
+/** The x-axis and one y-axis per channel: the first on the left, the others stacked on the right; zoom and pan
+ * survive a redraw of the same `revision`. */
+export function axesLayout(channels: CaptureChannel[], xTitle: string, revision: string): Record<string, unknown> {
+  const extra = Math.max(0, channels.length - 1);
   const layout: Record<string, unknown> = {
     xaxis: { title: { text: xTitle }, domain: [0, 1 - AXIS_GAP * extra], zeroline: false },
     margin: { l: 60, r: 50, t: 24, b: 44 },
     legend: { orientation: "h", y: -0.18 },
     hovermode: "x",
     dragmode: "zoom",
-    uirevision: capture.captured_at, // zoom and pan survive a redraw of the same capture
+    uirevision: revision,
   };
-  capture.channels.forEach((channel, n) => {
+  channels.forEach((channel, n) => {
     const axis: Record<string, unknown> = { title: { text: channel.unit || channel.key }, color: COLORS[n % 4], zeroline: false };
     if (n > 0) Object.assign(axis, { overlaying: "y", side: "right", anchor: "free", position: 1 - AXIS_GAP * (extra - n) });
     layout[n === 0 ? "yaxis" : `yaxis${n + 1}`] = axis;

@@ -38,7 +38,7 @@ function fieldRow(model: SequenceModel, number: number, keyword: Keyword, value:
 function editor(model: SequenceModel, number: number, keyword: Keyword, value: Value): HTMLElement {
   const set = (next: Value) => model.setValue(number, keyword.name, next);
   const testid = `field-${keyword.name}`;
-  if (keyword.pattern) return patternEditor(keyword.name, String(value ?? ""), set);
+  if (keyword.pattern) return patternEditor(keyword.name, String(value ?? ""), set, model.ioNames.val);
   if (keyword.constants) {
     const choices = ["", ...keyword.constants];
     return h("select", { "data-testid": testid, value: value ?? "", onchange: (event: Event) => set((event.target as HTMLSelectElement).value || null) },

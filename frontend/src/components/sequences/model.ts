@@ -7,6 +7,7 @@
 
 import { sequencesApi, type KeywordCatalog, type SequenceCheck, type SequenceRow } from "../../client/sequences";
 import { state, type State } from "../../lib/dom";
+import type { IoNames } from "../../lib/io-names";
 import { failure, type Message } from "../ui";
 import { merged, newSequence, toText, type Located, type Value } from "./text";
 
@@ -25,6 +26,8 @@ export class SequenceModel {
   readonly saved = state("");
   readonly message: State<Message | null> = state(null);
   readonly busy = state(false);
+  /** The drive's I/O configuration's names for the pattern bits (docs/io.md); null offline or until read. */
+  readonly ioNames: State<IoNames | null> = state(null);
   private revision: string | null = null;
   private pending: ReturnType<typeof setTimeout> | null = null;
 

@@ -21,12 +21,14 @@ import contextvars
 import logging
 import shutil
 import tempfile
+import time
 from collections.abc import Callable, Iterable, Mapping
-from concurrent.futures import ThreadPoolExecutor
+from concurrent.futures import Future, ThreadPoolExecutor
 from dataclasses import dataclass, field
 from pathlib import Path
 
 from servostudio.drive.access import Drive
+from servostudio.drive.sdo import LARGE_SAFETY_WAIT, OutcomeOverdue, settle
 from servostudio.errors import ServoStudioError
 from servostudio.formats.objectfile import ObjectEntry, format_object_file, write_object_file
 from servostudio.services.backup import FileKind, backup_drive, drive_file_kinds, restore_file
@@ -43,6 +45,9 @@ from servostudio.services.projects.service import ProjectService
 log = logging.getLogger(__name__)
 Progress = Callable[[dict[str, object]], None]
 DIRECTIONS = ("check", "download", "upload")
+#: Safety net of the wait for one axis's download or upload: every transfer of it has its own timeout, so this only
+#: ends the wait when a bus reader is stuck (a whole axis over the 19200-baud RS-232 link takes well under it)
+AXIS_SAFETY_WAIT = 2 * LARGE_SAFETY_WAIT
 
 
 @dataclass
@@ -255,19 +260,32 @@ def _install(
 
 
 def _parallel(reports: list[AxisReport], work: Callable[[AxisReport], None]) -> None:
-    """Run ``work`` for every axis at once; a failure is recorded in that axis's report."""
+    """Run ``work`` for every axis at once; a failure is recorded in that axis's report. The wait for all of them
+    is bounded (`AXIS_SAFETY_WAIT`, docs/reliability.md): an axis whose work has not ended by then is reported
+    overdue and not waited for, so a stuck bus reader cannot hang the commissioning job."""
     if not reports:
         return
-    with ThreadPoolExecutor(max_workers=len(reports), thread_name_prefix="commission") as pool:
+    pool = ThreadPoolExecutor(max_workers=len(reports), thread_name_prefix="commission")
+    deadline = time.monotonic() + AXIS_SAFETY_WAIT
+    try:
         # each axis's thread acts for the caller (motion guard, audit log): a copy of its context apiece
         futures = [(report, pool.submit(contextvars.copy_context().run, work, report)) for report in reports]
         for report, future in futures:
-            try:
-                future.result()
-            except Exception as error:  # reported per axis; the other axes go on; a bug is logged as well
-                if not isinstance(error, ServoStudioError):
-                    log.exception("commission of axis %s failed unexpectedly", report.link.axis.name)
-                report.error = str(error)
+            _settle_axis(report, future, deadline)
+    finally:
+        pool.shutdown(wait=False, cancel_futures=True)  # every future is done or overdue: nothing to wait for
+
+
+def _settle_axis(report: AxisReport, future: Future[None], deadline: float) -> None:
+    """Wait for one axis's work until the common deadline; its failure (or its being overdue) goes to its report."""
+    try:
+        settle(future, max(0.0, deadline - time.monotonic()))
+    except OutcomeOverdue:
+        report.error = f"no outcome of axis {report.link.axis.name} within {AXIS_SAFETY_WAIT:.0f} s; the bus is stuck"
+    except Exception as error:  # reported per axis; the other axes go on; a bug is logged as well
+        if not isinstance(error, ServoStudioError):
+            log.exception("commission of axis %s failed unexpectedly", report.link.axis.name)
+        report.error = str(error)
 
 
 def _relay(progress: Progress | None, project: str, link: AxisLink) -> Progress | None:

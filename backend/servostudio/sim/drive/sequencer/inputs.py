@@ -9,8 +9,10 @@ names (index << 16 | sub << 8 | bit): 0x3050,1 = 0x36010307 puts IN1 on bit 7 of
 
 The copy is made whenever an input, the polarity or a destination is written (and at power-on), not every
 period: idle inputs cost nothing. A bus write to a destination bit therefore holds until the input next changes.
-Not modelled here: the virtual links 0x3059,3, and the limit and home switches, which the simulated plant
-drives straight into 0x60FD bits 0–2.
+A destination among the input functions of 0x60FD (bits 0–15: limit switches, home, INHIBIT, …) is not copied
+into the object but handed to the drive (``DriveBehaviour.routed_inputs``), which ORs it with the plant's own
+switches and acts on it: an input configured as the positive limit switch blocks positive motion while it is
+active after its polarity (docs/io.md). Not modelled here: the virtual links 0x3059,3.
 """
 
 from __future__ import annotations
@@ -32,6 +34,7 @@ INPUT_COUNT = 10
 PHYSICAL_MASK = 0x001F
 VIRTUAL_MASK = 0x03E0
 DIGITAL_INPUTS_SHIFT = 16
+FUNCTIONS_INDEX = 0x60FD  # a destination 0x60FD00bb (bb < 16) gives the input function bb
 
 
 class LogicInputs:
@@ -66,8 +69,14 @@ class LogicInputs:
         drive = self.drive
         kept = int(drive.live("digital_inputs")) & ~((PHYSICAL_MASK | VIRTUAL_MASK) << DIGITAL_INPUTS_SHIFT)
         drive.write("digital_inputs", kept | levels << DIGITAL_INPUTS_SHIFT)
+        functions = 0
         for number in range(1, INPUT_COUNT + 1):
-            self._copy(int(store.get(DESTINATIONS, number)), levels >> (number - 1) & 1)
+            pointer, level = int(store.get(DESTINATIONS, number)), levels >> (number - 1) & 1
+            if pointer >> 16 == FUNCTIONS_INDEX and pointer & 0xFF00 == 0 and pointer & 0xFF < 16:
+                functions |= level << (pointer & 0xFF)
+            else:
+                self._copy(pointer, level)
+        drive.routed_inputs = functions
         drive.parameters_changed()  # a destination may be a parameter the drive took a snapshot of
 
     def _copy(self, pointer: int, level: int) -> None:
