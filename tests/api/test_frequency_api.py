@@ -1,7 +1,8 @@
 """The frequency response over REST on the server's simulated drive: refusals before anything is written (422, 409,
 404), then a job whose result is the result dict of the contract (issue #16), saved under the project's axis and
 listed there.  The measurement's accuracy is judged in tests/services/frequency (hidden plants, SYNC-locked drive);
-here the server's simulated drives are locked to the SYNC, as in the service tests."""
+here the server's own simulator (as ``make run`` has it) locks its drives to the measurement's SYNC
+(sim/sync_lock.py)."""
 
 from __future__ import annotations
 
@@ -11,20 +12,12 @@ from collections.abc import Iterator
 
 import pytest
 from tests.support.access import admin_app, api_client
-from tests.support.sync_locked import sync_locked_sim
 
 from servostudio.api.app import Settings
 
 NODE = "/api/buses/sim/nodes/1"
 ROUTE = f"{NODE}/frequency-response"
 QUICK = {"loop": "plant", "periods": 2, "base_speed_rad_s": 10.0, "position_window": 20.0}
-
-
-@pytest.fixture(scope="module", autouse=True)
-def locked():
-    """The simulated drives locked to the SYNC while the measurement streams (tests/support/sync_locked.py)."""
-    with sync_locked_sim(speed=2.0):
-        yield
 
 
 @pytest.fixture(scope="module")

@@ -14,18 +14,10 @@ import sys
 import httpx
 import pytest
 from tests.support.motion_timing import InProcessServer
-from tests.support.sync_locked import sync_locked_sim
 
 from servostudio.cli import main
 
 QUICK = ("--periods", "2", "--base-speed", "10", "--window", "20")
-
-
-@pytest.fixture(scope="module", autouse=True)
-def locked():
-    """The simulated drives locked to the SYNC while the measurement streams (tests/support/sync_locked.py)."""
-    with sync_locked_sim(speed=2.0):
-        yield
 
 
 @pytest.fixture(autouse=True)

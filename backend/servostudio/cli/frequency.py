@@ -25,9 +25,10 @@ from typing import Any
 
 from servostudio.cli import remote
 from servostudio.cli.audit import audit_log, guarded_connections, local_actor
+from servostudio.cli.jobrun import follow_job, forward_interrupt, interruptible
 from servostudio.cli.liveclient import LiveClient, axis_path
 from servostudio.cli.output import emit
-from servostudio.cli.procedures import EXIT_INTERRUPTED, _follow, _forward, _interruptible, confirm
+from servostudio.cli.procedures import EXIT_INTERRUPTED, confirm
 from servostudio.drive.link import LinkDownError
 from servostudio.errors import CommunicationError
 from servostudio.formats.textfile import write_bytes_atomic
@@ -40,6 +41,10 @@ from servostudio.services.scan import identified
 
 CONNECT_WAIT = 3.0
 EXIT_ABORTED = 5
+
+
+class MeasurementFailed(CommunicationError):
+    """The server's measurement job failed (its reason: the drive, the link, a refusal)."""
 
 
 class MeasurementAborted(CommunicationError):
@@ -89,7 +94,7 @@ def request_of(args: argparse.Namespace) -> MeasureRequest:
 def _run(args: argparse.Namespace) -> int:
     server = remote.Remote.of(args)
     request = request_of(args)
-    with _interruptible() as interrupted:
+    with interruptible() as interrupted:
         result = _remote(args, server, request, interrupted) if server else _local(args, request, interrupted)
     if result is None:
         print("error: frequency response interrupted; the axis is stopped, nothing written", file=sys.stderr)
@@ -127,7 +132,7 @@ def _local(args: argparse.Namespace, request: MeasureRequest, interrupted: threa
                     service.check(guard, axis, drive, FrequencyRequest(request))
                     confirm(args, _question(args))
                     cancellation = Cancellation()
-                    stop_watching = _forward(interrupted, cancellation)
+                    stop_watching = forward_interrupt(interrupted, cancellation)
                     try:
                         return service.run(guard, connection, drive, FrequencyRequest(request), _progress, cancellation)
                     except Cancelled:
@@ -148,8 +153,10 @@ def _remote(
     with LiveClient(server) as live, live.holding(bus, args.node):
         confirm(args, _question(args))
         job = live.call("POST", f"{axis_path(bus, args.node)}/frequency-response", body)
-        result = _follow(live, job["id"], interrupted)
-    return None if interrupted.is_set() else result
+        ended = follow_job(live, job["id"], interrupted)
+    if ended["state"] == "failed":
+        raise MeasurementFailed(str(ended["error"]))
+    return None if interrupted.is_set() else dict(ended["result"])
 
 
 def _progress(event: dict[str, object]) -> None:

@@ -15,17 +15,15 @@ from __future__ import annotations
 import argparse
 import sys
 import threading
-import time
 from typing import Any
 
 from servostudio.cli import remote
 from servostudio.cli.audit import audit_log, guarded_connections, local_actor
+from servostudio.cli.jobrun import follow_job, forward_interrupt, interruptible
+from servostudio.cli.jobrun import print_progress as progress
 from servostudio.cli.liveclient import LiveClient, axis_path
 from servostudio.cli.output import emit
-from servostudio.cli.procedures import CONNECT_WAIT, EXIT_INTERRUPTED, POLL, confirm
-from servostudio.cli.procedures import _forward as forward_interrupt
-from servostudio.cli.procedures import _interruptible as interruptible
-from servostudio.cli.procedures import _progress as progress
+from servostudio.cli.procedures import CONNECT_WAIT, EXIT_INTERRUPTED, confirm
 from servostudio.drive.link import LinkDownError
 from servostudio.errors import CommunicationError
 from servostudio.services import identification
@@ -141,15 +139,7 @@ def _remote(args: argparse.Namespace, server: remote.Remote | None, request: ide
 
 def _follow(live: LiveClient, job_id: str, interrupted: threading.Event) -> dict:
     """Until the job ends; interrupted: cancel it (the server quick-stops the axis) and wait for its end."""
-    cancelled = False
-    while True:
-        job = live.call("GET", f"/api/jobs/{job_id}")
-        if job["state"] != "running":
-            break
-        if interrupted.is_set() and not cancelled:
-            live.call("POST", f"/api/jobs/{job_id}/cancel")
-            cancelled = True
-        time.sleep(POLL)
+    job = follow_job(live, job_id, interrupted)
     if job["state"] == "cancelled":
         raise Cancelled(f"the server's identification job {job_id} was stopped")
     if job["state"] == "failed":

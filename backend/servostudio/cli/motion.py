@@ -14,14 +14,13 @@ as ``GET …/motion`` gives it; a motion that did not end ``done`` exits 3 (refu
 from __future__ import annotations
 
 import argparse
-import signal
 import threading
-from collections.abc import Callable, Iterator
-from contextlib import contextmanager
+from collections.abc import Callable
 from typing import Any
 
 from servostudio.cli import remote
 from servostudio.cli.audit import audit_log, guarded_connections, local_actor
+from servostudio.cli.jobrun import interruptible
 from servostudio.cli.liveclient import LiveClient, axis_path
 from servostudio.cli.output import emit
 from servostudio.drive.access import Drive
@@ -76,25 +75,12 @@ def _home(args: argparse.Namespace) -> tuple[str, dict[str, Any]]:
 
 def _run(args: argparse.Namespace, route: str, body: dict[str, Any]) -> int:
     server = remote.Remote.of(args)
-    with _interruptible() as interrupted:
+    with interruptible() as interrupted:
         ended = (_remote if server else _local)(args, server, route, body, interrupted)
     emit(ended)
     if ended["state"] != "done":
         raise MotionDidNotFinish(f"the {ended.get('kind') or route} ended {ended['state']}: {ended.get('reason')}")
     return 0
-
-
-@contextmanager
-def _interruptible() -> Iterator[threading.Event]:
-    """Ctrl-C, SIGTERM and SIGHUP set the event (the motion then gets a quick stop) instead of killing us."""
-    interrupted = threading.Event()
-    signals = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
-    previous = {sig: signal.signal(sig, lambda *_: interrupted.set()) for sig in signals}
-    try:
-        yield interrupted
-    finally:
-        for sig, handler in previous.items():
-            signal.signal(sig, handler)
 
 
 def _wait(current: Callable[[], dict | None], stop: Callable[[], dict], interrupted: threading.Event) -> dict:

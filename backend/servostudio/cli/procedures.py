@@ -20,16 +20,13 @@ likely cause on stderr) or the bus failed.
 from __future__ import annotations
 
 import argparse
-import signal
 import sys
 import threading
-import time
-from collections.abc import Callable, Iterator
-from contextlib import contextmanager
 from typing import Any
 
 from servostudio.cli import remote
 from servostudio.cli.audit import audit_log, guarded_connections, local_actor
+from servostudio.cli.jobrun import follow_job, forward_interrupt, interruptible, print_progress
 from servostudio.cli.liveclient import LiveClient, axis_path
 from servostudio.cli.output import emit
 from servostudio.drive.access import Drive
@@ -42,7 +39,6 @@ from servostudio.services.procedures import ProcedureFailed, ProcedureRequest, P
 from servostudio.services.scan import identified
 
 CONNECT_WAIT = 3.0
-POLL = 0.1
 EXIT_INTERRUPTED = 130
 #: command → procedure (semantic name)
 COMMANDS = {
@@ -100,7 +96,7 @@ def request_of(args: argparse.Namespace) -> ProcedureRequest:
 
 def _run(args: argparse.Namespace, name: str) -> int:
     server = remote.Remote.of(args)
-    with _interruptible() as interrupted:
+    with interruptible() as interrupted:
         result = (_remote if server else _local)(args, server, name, request_of(args), interrupted)
     emit(result)
     if result.get("status") == "aborted":
@@ -123,26 +119,6 @@ def confirm(args: argparse.Namespace, what: str) -> None:
 def _question(args: argparse.Namespace, label: str, moves: bool) -> str:
     warning = ": the motor will turn (shaft free, one revolution safe, limit switches clear)" if moves else ""
     return f"{label} on node {args.node} of bus {args.bus}{warning}"
-
-
-def _progress(event: dict[str, object]) -> None:
-    message, fraction = event.get("message"), event.get("fraction")
-    shown = f" {float(fraction) * 100:.0f} %" if isinstance(fraction, (int, float)) else ""
-    print(f"{event.get('phase')}: {message}{shown}", file=sys.stderr, flush=True)
-
-
-@contextmanager
-def _interruptible() -> Iterator[threading.Event]:
-    """Ctrl-C, SIGTERM and SIGHUP set the event (the procedure is then aborted) instead of killing us."""
-    interrupted = threading.Event()
-    main = threading.current_thread() is threading.main_thread()
-    signals = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP) if main else ()
-    previous = {sig: signal.signal(sig, lambda *_: interrupted.set()) for sig in signals}
-    try:
-        yield interrupted
-    finally:
-        for sig, handler in previous.items():
-            signal.signal(sig, handler)
 
 
 # ---- here: the command opens the bus -----------------------------------------------------------------------------
@@ -182,27 +158,13 @@ def _controlled(
             writes = service.check(guard, axis, drive, name, request)
             confirm(args, _question(args, description.label, description.moves))
             cancellation = Cancellation()
-            watcher = _forward(interrupted, cancellation)
+            watcher = forward_interrupt(interrupted, cancellation)
             try:
-                return service.run(guard, axis, drive, name, request, _progress, cancellation, writes)
+                return service.run(guard, axis, drive, name, request, print_progress, cancellation, writes)
             finally:
                 watcher()
         finally:
             guard.release(actor, axis, drive)
-
-
-def _forward(interrupted: threading.Event, cancellation: Cancellation) -> Callable[[], None]:
-    """Cancel the run when the command is interrupted; returns what stops watching."""
-    done = threading.Event()
-
-    def watch() -> None:
-        while not done.wait(POLL):
-            if interrupted.is_set():
-                cancellation.cancel()
-                return
-
-    threading.Thread(target=watch, name="procedure-interrupt", daemon=True).start()
-    return done.set
 
 
 # ---- through a server: the command is a live client of it --------------------------------------------------------
@@ -229,15 +191,7 @@ def _remote(
 
 def _follow(live: LiveClient, job_id: str, interrupted: threading.Event) -> dict:
     """Until the job ends; interrupted: cancel it (= abort) and wait for its end."""
-    cancelled = False
-    while True:
-        job = live.call("GET", f"/api/jobs/{job_id}")
-        if job["state"] != "running":
-            break
-        if interrupted.is_set() and not cancelled:
-            live.call("POST", f"/api/jobs/{job_id}/cancel")
-            cancelled = True
-        time.sleep(POLL)
+    job = follow_job(live, job_id, interrupted)
     if job["state"] == "failed":
         raise ProcedureFailed(str(job["error"]))
     return dict(job["result"])

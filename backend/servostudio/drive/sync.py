@@ -13,13 +13,20 @@ lower priority (SDO included) for good.
 
 from __future__ import annotations
 
+import logging
 import threading
 import time
 from collections.abc import Callable
 
+from servostudio.drive.access import Drive
 from servostudio.drive.link import BusLink, LinkDownError
+from servostudio.errors import ServoStudioError
+
+log = logging.getLogger(__name__)
 
 SYNC_COB_ID = 0x080
+#: CiA 301 communication cycle period (µs): the SYNC spacing a consumer synchronises its control cycle to
+CYCLE_PERIOD = (0x1006, 0)
 #: the shortest period offered: a Python thread on a loaded host keeps 1 ms to a fraction of it, not 100 µs
 MIN_PERIOD_S = 1e-3
 #: SYNCs sent whose answers have not all arrived, at most (the answers of one are on the bus while the next leaves)
@@ -90,3 +97,25 @@ class SyncProducer:
                 return
             self.sent.append(time.monotonic())
             k += 1
+
+
+def announce_cycle(drive: Drive, period_s: float) -> int | None:
+    """Write the SYNC period into the consumer's 0x1006, so that a drive that synchronises its cycle to the SYNC
+    (the simulator does: docs/simulator.md) expects this one; the value it had, to put back with `restore_cycle`.
+    None when the drive has no 0x1006 or refuses the value (it then runs on its own cycle, as without the write)."""
+    if drive.dictionary is None or drive.dictionary.get(*CYCLE_PERIOD) is None:
+        return None
+    try:
+        previous = int(drive.read(CYCLE_PERIOD).raw)
+        drive.write(CYCLE_PERIOD, round(period_s * 1e6))
+    except ServoStudioError as error:
+        log.warning("node %d: communication cycle period not set (%s); its cycle does not follow the SYNC", drive.node,
+                    error)  # fmt: skip
+        return None
+    return previous
+
+
+def restore_cycle(drive: Drive, previous: int | None) -> None:
+    """0x1006 back to what `announce_cycle` found (nothing when it wrote nothing)."""
+    if previous is not None:
+        drive.write(CYCLE_PERIOD, previous)

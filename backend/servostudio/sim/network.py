@@ -9,7 +9,9 @@ Two ways to run time:
   when nothing else is due, so a frame a control period produces (a TPDO, an EMCY) may reach the clients up to that
   late in wall-clock time, with its exact virtual time stamp (as a USB CAN adapter delivers in 1 ms packets). When
   the host cannot keep up, virtual time stays at most `MAX_LAG` behind the wall clock: it slips (runs slower than
-  real time) instead of catching up in a burst.
+  real time) instead of catching up in a burst. While SYNCs from a client come at the drives' communication cycle
+  period (0x1006), the thread follows them instead of the wall clock: the drives are SYNC-locked
+  (`servostudio.sim.sync_lock`).
 All access to the simulation goes through `lock`. Frames and actions from other threads enter with `inject` /
 `post`: while the thread runs they wait in a queue that it empties after every chunk, so a client's frame never
 waits for the lock behind a catch-up and enters the bus at the simulation's present.
@@ -41,6 +43,7 @@ from servostudio.sim.frame import Frame
 from servostudio.sim.node import Behaviour, SimulatedNode
 from servostudio.sim.objects import ObjectStore
 from servostudio.sim.sdo_server import DEFAULT_RESPONSE_TIME
+from servostudio.sim.sync_lock import SyncLock, Window
 
 log = logging.getLogger(__name__)
 
@@ -146,6 +149,9 @@ class SimulatedNetwork:
         self._ticks = 0
         self._node_list = list(self.nodes.values())
         self.clock.call_at(CONTROL_PERIOD, self._tick, lazy=True)
+        #: while running, SYNCs from outside lock the drives' cycle (servostudio.sim.sync_lock)
+        self.sync_lock = SyncLock(self._cycle_periods)
+        self._speed = 1.0
         self._thread: threading.Thread | None = None
         self._stop = threading.Event()
         self._posted: deque[Callable[[], None]] = deque()
@@ -186,10 +192,12 @@ class SimulatedNetwork:
     def running(self) -> bool:
         return self._thread is not None and self._thread.is_alive()
 
-    def start(self) -> None:
-        """Run in real time on a background (daemon) thread until `stop()`."""
+    def start(self, speed: float = 1.0) -> None:
+        """Run in real time on a background (daemon) thread until `stop()`; while free-running (no SYNC lock),
+        ``speed`` virtual seconds per wall-clock second (tests run faster than real time)."""
         if self.running:
             return
+        self._speed = speed
         self._stop.clear()
         pair = self._wake_pair = socket.socketpair()
         for end in pair:
@@ -212,21 +220,41 @@ class SimulatedNetwork:
 
     def _run(self, wake: socket.socket) -> None:
         """The clock thread; `wake` is the read end of the wake-up pair, open until the thread has ended."""
-        origin_wall = time.monotonic()
-        origin_virtual = self.clock.now
+        origin = (time.monotonic(), self.clock.now)  # (wall, virtual) instants free-running time counts from
+        locked: Window | None = None
         while not self._stop.is_set():
-            target = origin_virtual + (time.monotonic() - origin_wall)
             with self.lock:
+                was_locked, locked = locked, self.sync_lock.window(time.monotonic())
+                if was_locked is not None and locked is None:  # the SYNCs ended: free-running from here
+                    origin = (time.monotonic(), self.clock.now)
+                target = self._target(origin, locked)
                 self._run_chunk(min(target, self.clock.now + CHUNK))
                 behind = target - self.clock.now
                 due = self.clock.next_event_time()
-            if behind > MAX_LAG:
-                origin_wall += behind - MAX_LAG  # slip: the host is too slow, virtual time runs slower than real time
+            if behind > MAX_LAG and locked is None:
+                origin = (origin[0] + (behind - MAX_LAG) / self._speed, origin[1])  # slip: the host is too slow
             wait = 0.0
             if behind <= 0:  # until the next event, counted from now: running the chunk took time too
-                present = origin_virtual + (time.monotonic() - origin_wall)
+                present = self._target(origin, locked)
                 wait = IDLE_WAIT if due is None else min(IDLE_WAIT, due - present)
             self._wait_for_readers(wake, max(wait, 0.0))
+
+    def _target(self, origin: tuple[float, float], locked: Window | None) -> float:
+        """The virtual time due now: paced from ``origin``, or while SYNC-locked from the last slot to its ceiling."""
+        if locked is None:
+            return origin[1] + (time.monotonic() - origin[0]) * self._speed
+        return min(locked.slot + (time.monotonic() - locked.wall) * self._speed, locked.ceiling)
+
+    def _cycle_periods(self) -> set[float]:
+        return {period for node in self._node_list if (period := node.cycle_period()) > 0}
+
+    def _transmit_from_outside(self, frame: Frame, sender: Station | None) -> None:
+        """A client's frame onto the bus; while running, a SYNC first runs the drives to its slot (sync_lock)."""
+        if self.running and any(node.consumes_sync(frame) for node in self._node_list):
+            slot = self.sync_lock.slot(self.clock.now, time.monotonic())
+            if slot > self.clock.now:
+                self.clock.run_until(slot)
+        self.bus.transmit(frame, sender)
 
     def _wait_for_readers(self, wake: socket.socket, seconds: float) -> None:
         """Wait up to `seconds` for a watched socket or a wake-up, and serve what is readable. `select` waits to the
@@ -274,7 +302,7 @@ class SimulatedNetwork:
 
     def inject(self, frame: Frame, sender: Station | None = None) -> None:
         """Put a frame from outside (client, socketcand, serial) on the bus at the current virtual time."""
-        self.post(lambda: self.bus.transmit(frame, sender))
+        self.post(lambda: self._transmit_from_outside(frame, sender))
 
     def post(self, action: Callable[[], None]) -> None:
         """Run `action` inside the simulation: while running, on its thread after the current chunk (the caller does

@@ -215,6 +215,17 @@ class SimulatedNode:
         """0x1005 bits 0–10 (read for every frame on the bus, so without the checked access)."""
         return self._read_sync_cob_id() & 0x7FF
 
+    def consumes_sync(self, frame: Frame) -> bool:
+        """Whether ``frame`` is this node's SYNC."""
+        return not frame.rtr and not frame.extended and frame.can_id == self._sync_id()
+
+    def cycle_period(self) -> float:
+        """The communication cycle period 0x1006 (s) this node expects its SYNC at; 0 when none is configured or the
+        node produces the SYNC itself (0x1005 bit 30)."""
+        if self._value(SYNC_COB_ID) & 0x40000000:
+            return 0.0
+        return self._value(SYNC_PERIOD) * 1e-6
+
     def _on_sync(self) -> None:
         self.behaviour.on_sync()
         self.pdo.on_sync()

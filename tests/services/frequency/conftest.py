@@ -1,8 +1,6 @@
 """Benches for the frequency response: simulated XtrapulsPacs commissioned for HIDDEN seeded plants, in this process,
-with a clock that runs faster than the wall clock while nothing streams, and is locked to the SYNC while the
-measurement streams its excitation (docs/frequency-response.md §4).
-
-Why the lock: tests/support/sync_locked.py.
+running in real time as the server's simulator does (faster than the wall clock while nothing streams), and so
+locked to the SYNC while the measurement streams its excitation (docs/frequency-response.md §4, sim/sync_lock.py).
 """
 
 from __future__ import annotations
@@ -11,7 +9,6 @@ from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field, replace
 
 import pytest
-from tests.support.sync_locked import locked_network
 
 from servostudio.drive.access import Drive
 from servostudio.services.audit import Actor, acting_as
@@ -74,11 +71,12 @@ class Bench:
 
 def open_bench(plant: Plant, speed: float) -> Bench:
     """One commissioned XtrapulsPac (node 1) on ``plant``: gains tuned for the plant as a machine in service has."""
-    bus, simulation, network = locked_network(
-        "1", speed, lambda device, node, store, events: make_behaviour(device, store, plant, events, True)
+    network = SimulatedNetwork(
+        "1", behaviour_factory=lambda device, node, store, events: make_behaviour(device, store, plant, events, True)
     )
+    network.start(speed)
     manager = ConnectionManager()
-    manager._opener = lambda spec: (bus, simulation)  # type: ignore[method-assign]
+    manager._opener = lambda spec: (network.open_bus, network)  # type: ignore[method-assign]
     connection = manager.open("sim", wait=5.0)
     assert connection.link.wait_connected(5.0)
     connection.engine.timeout = SDO_TIMEOUT

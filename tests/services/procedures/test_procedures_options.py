@@ -10,7 +10,7 @@ from servostudio.drive.access import Drive
 from servostudio.drive.profiles import PROFILES
 from servostudio.od import builtin_library
 from servostudio.services.procedures import BadOptions
-from servostudio.services.procedures.options import option_writes
+from servostudio.services.procedures.options import option_writes, shown
 
 LIBRARY = builtin_library()
 DRIVES = {device: Drive(None, 1, LIBRARY.load(device)) for device in ("xtrapulspac", "cd1k")}  # type: ignore[arg-type]
@@ -60,3 +60,10 @@ def _combinations(description, key, drive):
     for codes in sets:
         combos = [[*combo, code] for combo in combos for code in codes]
     return combos
+
+
+def test_a_result_shows_a_choice_alike_whether_given_as_number_or_text():
+    """REST gives ``{"bandwidth": 100}``, the CLI ``"100"``: a saved result must not depend on the face used."""
+    assert shown("auto_tuning", {"bandwidth": 100}) == shown("auto_tuning", {"bandwidth": "100"})
+    assert shown("auto_tuning", {"bandwidth": 100.0, "speed_filter": 0.5})["speed_filter"] == "0.5"
+    assert shown("current_loop", {"inductance_mh": 2.5}) == {"inductance_mh": 2.5}  # a physical value stays a number

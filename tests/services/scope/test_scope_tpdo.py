@@ -139,7 +139,7 @@ def test_a_polled_capture_is_labelled_poll(bench):
         (CaptureDefinition(("0x6064,0",), period_us=250), "SYNC producer sets the rate, every 1000 µs at the fastest"),
         (CaptureDefinition(("0x6064,0",), period_us=1000, trigger=Trigger("0x606C,0", "rising", 1)),
          "the trigger must be one of the channels"),
-        (CaptureDefinition(("0x6064,0", "0x6064,0@1"), source="recorder"), "not the recorder"),
+        (CaptureDefinition(("0x6064,0", "0x6064,0@1"), source="recorder"), "node 2 \\(cd1k\\): no recorder"),
         (CaptureDefinition(("0x6064,0",), period_us=1000, mode="normal"), "need the drive's recorder"),
         (CaptureDefinition(("0x6064,0",) * 7, period_us=1000, source="tpdo"), "do not fit the TPDOs"),
     ],

@@ -134,3 +134,52 @@ def test_an_output_without_source_is_the_buses():
     h.write(0x60FE, 1, 1 << 17)  # OUT2 set by the bus
     h.run(0.05)
     assert int(h.read(0x60FE, 1)) & 1 << 17
+
+
+def test_homing_finds_the_home_switch_an_input_is_configured_as():
+    """A plant without a home switch of its own: IN3 routed to the home function is the switch homing looks for; its
+    edge (24 V taken away on the test bench 0x5F00) ends the run, as the edge of a real cam would."""
+    h = WiredHarness("xtrapulspac", replace(Plant.commissioned(), home_switch=None))
+    h.write(0x3050, 3, 0x60FD0002)  # IN3 → home switch
+    h.write(WIRING, 0, 0b100)  # 24 V on IN3: the cam is under the sensor
+    h.write(0x6098, 0, 19)  # home switch, no index
+    h.write(0x6099, 1, REV * 2)
+    h.write(0x6099, 2, REV // 2)
+    h.write(0x609A, 0, REV * 200)
+    h.enable(6)
+    h.control(0x1F)
+    h.run(0.2)
+    assert h.status & 0x3400 == 0  # still homing: the switch has not changed
+    h.write(WIRING, 0, 0)  # the edge
+    h.run_until(lambda: h.status & 0x3400 in (0x1400, 0x2400, 0x2000), 3.0)
+    assert h.status & 0x3400 == 0x1400, f"homing did not end on the configured input: status {h.status:#06x}"
+
+
+def test_an_input_configured_as_reset_clears_a_fault_on_its_rising_edge():
+    h = WiredHarness("xtrapulspac")
+    h.write(0x3050, 4, 0x60FD000C)  # IN4 → RESET (0x60FD bit 12)
+    h.run(0.01)
+    h.drive.raise_error(35)  # a following error whose cause has gone (the fault-injection entry)
+    h.run(0.01)
+    assert h.status & 0x08  # fault
+    h.write(WIRING, 0, 0b1000)  # 24 V on IN4: the rising edge
+    h.run(0.01)
+    assert not h.status & 0x08 and h.status & 0x4F == 0x40  # switch on disabled, fault reset
+    assert int(h.read(0x60FD)) & 1 << 12
+
+
+def test_an_input_configured_as_quick_stop_stops_the_axis_and_keeps_it_from_enabling():
+    h = WiredHarness("xtrapulspac")
+    h.write(0x3050, 5, 0x60FD000F)  # IN5 → QUICK STOP (0x60FD bit 15)
+    speed_mode(h, 2 * REV)
+    assert moved(h, 0.1) > 0.1
+    h.write(WIRING, 0, 0b10000)  # 24 V on IN5
+    h.run(0.3)
+    assert h.status & 0x6F != 0x27 and abs(moved(h, 0.1)) < 0.01  # quick-stopped, standing
+    h.control(0x06)
+    h.control(0x07)
+    h.control(0x0F, settle=0.01)
+    assert h.status & 0x6F != 0x27  # not enabled while the input is active
+    h.write(WIRING, 0, 0)
+    h.enable()
+    assert h.status & 0x6F == 0x27

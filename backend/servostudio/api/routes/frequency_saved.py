@@ -14,9 +14,9 @@ from typing import Any
 from fastapi import APIRouter, Query, Response, status
 
 from servostudio.api.deps import Projects
+from servostudio.api.downloads import file_download as download
 from servostudio.api.errors import error_responses
 from servostudio.api.routes.frequency_saved_models import SavedFrequencyResult, SavedFrequencySummary
-from servostudio.api.routes.scope import _download as download  # one file-download helper (RFC 5987 names)
 from servostudio.api.security import Requires
 from servostudio.errors import ErrorKind
 from servostudio.services.frequency.saved import SavedFrequency

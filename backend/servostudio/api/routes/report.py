@@ -8,11 +8,11 @@ only for callers who may read the audit log (Expert and above), for the others t
 from __future__ import annotations
 
 from typing import Annotated
-from urllib.parse import quote
 
 from fastapi import APIRouter, Query, Response
 
 from servostudio.api.deps import Caller, Projects, Server
+from servostudio.api.downloads import attachment
 from servostudio.api.errors import error_responses
 from servostudio.api.security import Requires
 from servostudio.errors import ErrorKind
@@ -40,10 +40,4 @@ def get_report(
 ) -> Response:
     audit = state.audit if user.level.at_least(AUDIT_LEVEL) else None
     html = report_html(projects, project, axis, audit)
-    return Response(html, media_type="text/html; charset=utf-8", headers=_attachment(report_file_name(project, axis)))
-
-
-def _attachment(file_name: str) -> dict[str, str]:
-    """A download's name, also in RFC 5987 form, so a non-ASCII project name arrives whole."""
-    fallback = file_name.encode("ascii", "replace").decode().replace('"', "'")
-    return {"Content-Disposition": f"attachment; filename=\"{fallback}\"; filename*=UTF-8''{quote(file_name)}"}
+    return Response(html, media_type="text/html; charset=utf-8", headers=attachment(report_file_name(project, axis)))

@@ -12,12 +12,12 @@ import asyncio
 import contextlib
 import json
 from collections.abc import Callable
-from urllib.parse import quote
 
 from fastapi import APIRouter, Response, WebSocket, WebSocketDisconnect, status
 
 from servostudio.api.auth import identify
 from servostudio.api.deps import Access, Jobs, NodeDrive, OpenBus, Projects, ScopeCaptures
+from servostudio.api.downloads import file_download
 from servostudio.api.errors import error_body, error_responses
 from servostudio.api.routes.comm_models import JobModel
 from servostudio.api.routes.drives import DRIVE_ERRORS
@@ -216,7 +216,7 @@ def get_capture(bus: str, node: int, capture_id: str, scope: ScopeCaptures) -> C
 )
 def get_capture_csv(bus: str, node: int, capture_id: str, scope: ScopeCaptures) -> Response:
     made = _live(scope, bus, node, capture_id)
-    return _download(capture_csv(made), "text/csv", f"{_default_name(made)}.csv")
+    return file_download(capture_csv(made), "text/csv", f"{_default_name(made)}.csv")
 
 
 @router.get(
@@ -228,7 +228,7 @@ def get_capture_csv(bus: str, node: int, capture_id: str, scope: ScopeCaptures) 
 )
 def get_capture_html(bus: str, node: int, capture_id: str, scope: ScopeCaptures) -> Response:
     made = _live(scope, bus, node, capture_id)
-    return _download(capture_html(made), "text/html", f"{_default_name(made)}.html")
+    return file_download(capture_html(made), "text/html", f"{_default_name(made)}.html")
 
 
 def _live(scope: ScopeCaptures, bus: str, node: int, capture_id: str) -> Capture:
@@ -285,7 +285,7 @@ def open_saved(project: str, axis: str, name: str, projects: Projects) -> Captur
 )
 def saved_csv(project: str, axis: str, name: str, projects: Projects) -> Response:
     made = CaptureStore(projects.store).open(project, axis, name)
-    return _download(capture_csv(made), "text/csv", f"{name}.csv")
+    return file_download(capture_csv(made), "text/csv", f"{name}.csv")
 
 
 @router.get(
@@ -297,7 +297,7 @@ def saved_csv(project: str, axis: str, name: str, projects: Projects) -> Respons
 )
 def saved_html(project: str, axis: str, name: str, projects: Projects) -> Response:
     made = CaptureStore(projects.store).open(project, axis, name)
-    return _download(capture_html(made), "text/html", f"{name}.html")
+    return file_download(capture_html(made), "text/html", f"{name}.html")
 
 
 @router.delete(
@@ -315,10 +315,3 @@ def delete_saved(project: str, axis: str, name: str, projects: Projects) -> Resp
 
 def _default_name(made: Capture) -> str:
     return made.name or f"capture node{made.drive.node} {made.captured_at.replace(':', '-')}"
-
-
-def _download(body: str, media_type: str, file_name: str) -> Response:
-    """A file download; the name also in RFC 5987 form, so a non-ASCII name arrives whole."""
-    fallback = file_name.encode("ascii", "replace").decode().replace('"', "'")
-    disposition = f"attachment; filename=\"{fallback}\"; filename*=UTF-8''{quote(file_name)}"
-    return Response(body, media_type=media_type, headers={"Content-Disposition": disposition})

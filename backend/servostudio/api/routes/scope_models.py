@@ -10,6 +10,7 @@ from pydantic import BaseModel, ConfigDict, Field
 
 from servostudio.api.routes.comm_models import JobModel
 from servostudio.services.scope import Capture, CaptureDefinition, ChannelInfo, SavedCapture, Trigger
+from servostudio.services.scope.multi import MultiPlan
 from servostudio.services.scope.plan import CapturePlan
 from servostudio.services.scope.stream_plan import StreamPlan
 
@@ -212,8 +213,10 @@ def saved_model(saved: SavedCapture) -> SavedCaptureModel:
     return SavedCaptureModel(**fields)
 
 
-def plan_model(plan: CapturePlan | StreamPlan) -> PlanModel:
+def plan_model(plan: CapturePlan | StreamPlan | MultiPlan) -> PlanModel:
     """The plan as the check route answers it."""
+    if isinstance(plan, MultiPlan):
+        return _multi_model(plan)
     if isinstance(plan, StreamPlan):
         preview = plan.describe()
         return PlanModel(
@@ -233,6 +236,27 @@ def plan_model(plan: CapturePlan | StreamPlan) -> PlanModel:
         multiplier=plan.multiplier,
         record_size=plan.record_size,
         bytes=plan.total_bytes,
+    )
+
+
+def _multi_model(plan: MultiPlan) -> PlanModel:
+    """A recorder capture of several axes: the channels in the capture's order (``OBJ@NODE`` of other axes), the
+    sizes summed over the axes' recorders."""
+    channels: list[ChannelModel | None] = [None] * len(plan.definition.channels)
+    for axis in plan.axes:
+        suffix = "" if axis.drive.node == plan.node else f"@{axis.drive.node}"
+        for position, channel in zip(axis.positions, axis.plan.channels, strict=True):
+            info = vars(ChannelInfo.of(channel.variable))
+            channels[position] = ChannelModel(**(info | {"key": info["key"] + suffix}))
+    return PlanModel(
+        source="recorder",
+        channels=[channel for channel in channels if channel is not None],
+        period_ns=plan.period_ns,
+        samples=plan.depth,
+        pre_trigger=0,
+        multiplier=plan.axes[0].plan.multiplier,
+        record_size=sum(axis.plan.record_size for axis in plan.axes),
+        bytes=sum(axis.plan.total_bytes for axis in plan.axes),
     )
 
 

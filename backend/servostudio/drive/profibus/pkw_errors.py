@@ -3,6 +3,8 @@ Chapter 1 §3.2, L334-344): AK 7 with an error number in PWE, AK 8 when the PKW 
 
 from __future__ import annotations
 
+from servostudio.errors import Conflict
+
 ERROR_TEXTS = {
     0: "illegal PNU",
     1: "parameter cannot be modified",
@@ -14,8 +16,8 @@ ERROR_TEXTS = {
 }
 
 
-class PkwError(Exception):
-    """A parameter request the drive did not carry out."""
+class PkwError(Conflict):
+    """A parameter request the drive did not carry out (like an SDO abort: the drive's state or rules refused it)."""
 
     def __init__(self, pnu: int, index: int, reason: str) -> None:
         self.pnu = pnu

@@ -50,6 +50,12 @@ class PkwChannel:
         if self._phase is _Phase.READY:
             self._phase = _Phase.PENDING
 
+    def abandon(self) -> None:
+        """Give up the pending request (its reply did not come in time, or the link was lost): AK 0 goes out
+        next, and the next request waits until the slave shows AK 0, so a late reply cannot answer it."""
+        self._request = None
+        self._phase = _Phase.SEPARATING
+
     def output(self) -> PkwMessage:
         """The PKW module of the next PPO write."""
         if self._phase is _Phase.PENDING and self._request is not None:

@@ -3,7 +3,9 @@
 The RPDO the measurement borrows (the highest-numbered one the dictionary has) is read whole first and written back
 at the end, whatever happens; it is mapped with the one excited object (the torque offset or the target velocity)
 and made synchronous (transmission type 1: the drive applies the value at the next SYNC, so every value takes effect
-at a SYNC instant).  The node is started (NMT, RPDOs act only in OPERATIONAL) and put back to PRE-OPERATIONAL
+at a SYNC instant).  The drive's communication cycle period 0x1006 is set to the SYNC period and put back after:
+a drive that synchronises its cycle to the SYNC (the simulator does) then takes the values one period apart however
+late the SYNC thread is.  The node is started (NMT, RPDOs act only in OPERATIONAL) and put back to PRE-OPERATIONAL
 afterwards when it was not operational before.  Just before SYNC k the producer's hook sends value k
 (``value_of(k)``): value and SYNC leave back to back from one thread, in that order.
 """
@@ -12,38 +14,17 @@ from __future__ import annotations
 
 import struct
 from collections.abc import Callable
-from dataclasses import dataclass
 
 from servostudio.drive.access import Drive
 from servostudio.drive.link import BusLink
 from servostudio.drive.nmt import NmtCommand, send_nmt
-from servostudio.drive.sync import SyncProducer
-from servostudio.drive.tpdo import COB_ID_INVALID, COB_ID_MASK, mapping_entry
-from servostudio.errors import CommunicationError, ServoStudioError
+from servostudio.drive.rpdo import APPLY_AT_SYNC, RpdoConfig, last_rpdo, mapped, read_rpdo, write_rpdo
+from servostudio.drive.sync import SyncProducer, announce_cycle, restore_cycle
+from servostudio.errors import ServoStudioError
 from servostudio.od.datatypes import DataType
 from servostudio.od.model import Variable
 
-RPDO_COMMUNICATION, RPDO_MAPPING = 0x1400, 0x1600
-RPDO_LIMIT = 512
-APPLY_AT_EVERY_SYNC = 1
 FORMATS = {DataType.INTEGER16: "<h", DataType.INTEGER32: "<i", DataType.UNSIGNED16: "<H", DataType.UNSIGNED32: "<I"}
-
-
-class NoRpdo(CommunicationError):
-    """The drive offers no receive PDO the measurement can map its excitation into."""
-
-
-@dataclass(frozen=True)
-class RpdoConfig:
-    number: int  # 0-based
-    cob_id: int
-    transmission_type: int
-    entries: tuple[int, ...]
-    count: int
-
-    @property
-    def identifier(self) -> int:
-        return self.cob_id & COB_ID_MASK
 
 
 class ExcitationStream:
@@ -55,13 +36,15 @@ class ExcitationStream:
         self.saved: RpdoConfig | None = None
         self.producer: SyncProducer | None = None
         self.started_node = False
+        self.cycle: int | None = None  # the drive's communication cycle period before (None: not written)
 
     def open(self, operational: bool) -> None:
-        """Borrow and map the RPDO; start the node unless it is OPERATIONAL already (``operational``)."""
-        number = _last_rpdo(self.drive)
-        self.saved = _read(self.drive, number)
-        entry = mapping_entry(self.variable)
-        _write(self.drive, RpdoConfig(number, self.saved.identifier, APPLY_AT_EVERY_SYNC, (entry,), 1))
+        """Borrow and map the RPDO, announce the SYNC period (0x1006: a drive locked to the SYNC applies the values
+        one period apart however late the SYNC thread is); start the node unless OPERATIONAL (``operational``)."""
+        number = last_rpdo(self.drive)
+        self.saved = read_rpdo(self.drive, number)
+        self.cycle = announce_cycle(self.drive, self.period_s)
+        write_rpdo(self.drive, mapped(number, self.saved.identifier, [self.variable], APPLY_AT_SYNC))
         if not operational:
             send_nmt(self.link, NmtCommand.START, self.drive.node)
             self.started_node = True
@@ -87,12 +70,17 @@ class ExcitationStream:
             self.producer.stop()
 
     def close(self) -> str | None:
-        """SYNC stopped, the RPDO written back, the node back to PRE-OPERATIONAL if started; what failed, or None."""
+        """SYNC stopped, the RPDO and 0x1006 written back, the node back to PRE-OPERATIONAL if started; what failed,
+        or None."""
         self.stop()
         failures = []
+        try:
+            restore_cycle(self.drive, self.cycle)
+        except ServoStudioError as error:
+            failures.append(f"communication cycle period not written back: {error}")
         if self.saved is not None:
             try:
-                _write(self.drive, self.saved)
+                write_rpdo(self.drive, self.saved)
             except ServoStudioError as error:
                 failures.append(f"RPDO {self.saved.number + 1} not written back: {error}")
         if self.started_node:
@@ -101,49 +89,3 @@ class ExcitationStream:
             except ServoStudioError as error:
                 failures.append(f"node left OPERATIONAL: {error}")
         return "; ".join(failures) or None
-
-
-def _last_rpdo(drive: Drive) -> int:
-    dictionary = drive.dictionary
-    for number in reversed(range(RPDO_LIMIT)):
-        if (
-            dictionary is not None
-            and dictionary.get(RPDO_MAPPING + number, 1) is not None
-            and (dictionary.get(RPDO_COMMUNICATION + number, 1) is not None)
-        ):
-            return number
-    raise NoRpdo(f"node {drive.node}: the {drive.profile.device} has no receive PDO to carry the excitation")
-
-
-def _read(drive: Drive, number: int) -> RpdoConfig:
-    communication, mapping = RPDO_COMMUNICATION + number, RPDO_MAPPING + number
-    keys = [(communication, 1), (communication, 2), (mapping, 0)]
-    count_entries = sum(1 for sub in range(1, 65) if drive.dictionary and drive.dictionary.get(mapping, sub))
-    keys += [(mapping, sub) for sub in range(1, count_entries + 1)]
-    values = [_raw(outcome) for outcome in drive.submit_read_all([drive.variable(key) for key in keys]).outcomes()]
-    return RpdoConfig(number, values[0], values[1], tuple(values[3:]), values[2])
-
-
-def _write(drive: Drive, config: RpdoConfig) -> None:
-    """CiA 301's order: COB-ID invalid, count 0, the entries, the count, the transmission type, COB-ID as given."""
-    communication, mapping = RPDO_COMMUNICATION + config.number, RPDO_MAPPING + config.number
-    writes: list[tuple[tuple[int, int], int]] = [
-        ((communication, 1), config.cob_id | COB_ID_INVALID),
-        ((mapping, 0), 0),
-        *(((mapping, sub), entry) for sub, entry in enumerate(config.entries, 1)),
-        ((mapping, 0), config.count),
-        ((communication, 2), config.transmission_type),
-        ((communication, 1), config.cob_id),
-    ]
-    batch = drive.submit_write_all([(drive.variable(key), value) for key, value in writes])
-    for outcome in batch.outcomes():
-        if isinstance(outcome, Exception):
-            raise outcome
-
-
-def _raw(outcome: object) -> int:
-    if isinstance(outcome, Exception):
-        raise outcome
-    value = getattr(outcome, "raw", None)
-    assert isinstance(value, int)
-    return value

@@ -54,8 +54,11 @@ def option_writes(drive: Drive, name: str, description: ProcedureDescription, gi
 
 
 def shown(name: str, given: Mapping[str, Any]) -> dict[str, object]:
-    """The options a run used, defaults filled in (for the result)."""
-    return {**DEFAULTS.get(name, {}), **{key: value for key, value in given.items() if value is not None}}
+    """The options a run used, defaults filled in (for the result); a choice spelled as its label whether the
+    request gave 75 (REST) or "75" (CLI), so saved results compare alike."""
+    defaults = DEFAULTS.get(name, {})
+    chosen = {key: _text(value) if key in defaults else value for key, value in given.items() if value is not None}
+    return {**defaults, **chosen}
 
 
 def _chosen(drive: Drive, name: str, description: ProcedureDescription, given: Mapping[str, Any]) -> dict[str, Any]:

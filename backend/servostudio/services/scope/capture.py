@@ -123,7 +123,8 @@ class Capture:
     captured_at: str  # ISO 8601, UTC
     source: str = "recorder"
     name: str = field(default="", compare=False)  # the saved capture's name in its project (empty: not saved)
-    #: TPDO and polled captures: the largest distance of a sample from its instant (SYNC jitter, a poll's reads)
+    #: TPDO and polled captures: the largest distance of a sample from its instant (SYNC jitter, a poll's reads);
+    #: recorder captures of several axes: the largest offset between two axes' samples (multi.py)
     alignment_ns: int | None = field(default=None, compare=False)
 
     @property

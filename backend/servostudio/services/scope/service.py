@@ -29,6 +29,7 @@ from servostudio.services.bus import BusConnection, Job, JobRegistry
 from servostudio.services.cancel import Cancellation, Cancelled
 from servostudio.services.scope.capture import Capture, ChannelInfo, DriveIdentity, build_capture
 from servostudio.services.scope.definition import CaptureDefinition, split_channel
+from servostudio.services.scope.multi import MultiPlan, MultiRecorderCapture, plan_multi
 from servostudio.services.scope.plan import CapturePlan, CaptureRefused, plan_capture, recorder_of
 from servostudio.services.scope.presets import presets_for
 from servostudio.services.scope.recorder import POLL_SECONDS, RecorderSession, Report
@@ -75,20 +76,25 @@ def session_of(drive: Drive) -> RecorderSession:
     return RecorderSession(drive, recorder_of(drive))
 
 
+def own_channels(drive: Drive, definition: CaptureDefinition) -> bool:
+    """Are all the channels the drive's own (none ``OBJ@NODE`` of another axis)?"""
+    return all(split_channel(channel)[1] in (None, drive.node) for channel in definition.channels)
+
+
 def by_recorder(drive: Drive, definition: CaptureDefinition) -> bool:
-    """Does this capture use the drive's recorder? Asked for, or (auto) one drive that has one."""
-    own = all(split_channel(channel)[1] in (None, drive.node) for channel in definition.channels)
-    if definition.source == "recorder" and not own:
-        raise CaptureRefused("channels of several axes are captured through TPDOs or by polling, not the recorder")
+    """Does this capture use the drives' recorders? Asked for (one axis or several), or (auto) one drive that has
+    one."""
     if definition.source == "recorder":
         return True
-    return definition.source == "auto" and own and drive.profile.recorder is not None
+    return definition.source == "auto" and own_channels(drive, definition) and drive.profile.recorder is not None
 
 
 def check(drive: Drive, definition: CaptureDefinition, axes: Axes | None = None,
-          bitrate: int | None = None) -> CapturePlan | StreamPlan:  # fmt: skip
+          bitrate: int | None = None) -> CapturePlan | StreamPlan | MultiPlan:  # fmt: skip
     """The plan of a capture, or its refusal; reads only read-only objects (the recorder's limits; a poll plan
     times one round of reads). ``axes`` gives the other nodes of the bus (channels ``OBJ@NODE``)."""
+    if by_recorder(drive, definition) and not own_channels(drive, definition):
+        return plan_multi(drive, axes or _alone(drive), definition)
     if by_recorder(drive, definition):
         session = session_of(drive)
         return plan_capture(drive, session.recorder, session.limits(), definition)
@@ -117,12 +123,17 @@ def record_once(session: RecorderSession, plan: CapturePlan, identity: DriveIden
 
 def capture(drive: Drive, identity: DriveIdentity, definition: CaptureDefinition, report: Report | None = None,
             cancellation: Cancellation | None = None, axes: Axes | None = None,
-            bitrate: int | None = None) -> Capture:  # fmt: skip
-    """One capture, start to end (what the CLI does; a job does it in a loop for normal and auto mode)."""
+            bitrate: int | None = None, operational: Callable[[int], bool] | None = None) -> Capture:  # fmt: skip
+    """One capture, start to end (what the CLI does; a job does it in a loop for normal and auto mode).
+    ``operational`` says which nodes are OPERATIONAL (a recorder capture of several axes starts the others for its
+    broadcast arm and puts them back to PRE-OPERATIONAL; unknown: none is)."""
     plan = check(drive, definition, axes, bitrate)
     report, cancellation = report or _quiet, cancellation or Cancellation()
     if isinstance(plan, StreamPlan):
         return stream_once(drive, plan, identity, report, cancellation, axes)
+    if isinstance(plan, MultiPlan):
+        run = MultiRecorderCapture(plan, drive.engine.link, operational or _not_operational)
+        return run.run(report, cancellation, identity)
     session = session_of(drive)
     session.configure(plan)
     return record_once(session, plan, identity, report, cancellation)
@@ -148,6 +159,11 @@ def roll(drive: Drive, identity: DriveIdentity, definition: CaptureDefinition, s
     record = RollRecord(channels, plan.period_ns, identity, _now())
     RollStream(plan, _reach(drive, plan, axes), drive.engine.link, record.take, seconds).run(_quiet, cancellation)
     return record
+
+
+def _not_operational(node: int) -> bool:
+    """A node whose NMT state is not known is taken as not OPERATIONAL (started, and put back after)."""
+    return False
 
 
 def _now() -> str:
@@ -238,9 +254,12 @@ class ScopeService:
         identity = identity_of(connection, drive)
 
         def work(progress: Callable[[dict[str, object]], None], cancellation: Cancellation) -> object:
+            if isinstance(plan, MultiPlan):
+                operational = lambda other: connection.nmt_state(other) == "OPERATIONAL"  # noqa: E731
+                return self._run_axes(drive, plan, identity, _on_node(progress, node), cancellation, operational)
             return self._run(drive, plan, identity, _on_node(progress, node), cancellation, connection.drive)
 
-        nodes = plan.nodes if isinstance(plan, StreamPlan) else (drive.node,)
+        nodes = plan.nodes if isinstance(plan, StreamPlan | MultiPlan) else (drive.node,)
         sync = isinstance(plan, StreamPlan) and plan.source == "tpdo"
         return self._claim(connection.id, nodes, lambda: jobs.start("scope", work), sync)
 
@@ -322,6 +341,16 @@ class ScopeService:
             if not made:
                 raise  # stopped before the first recording: nothing to show
         return {"capture": made[-1], "captures": len(made), "bus": identity.bus, "node": identity.node}
+
+    def _run_axes(self, drive: Drive, plan: MultiPlan, identity: DriveIdentity, report: Report,
+                  cancellation: Cancellation, operational: Callable[[int], bool]) -> dict[str, object]:  # fmt: skip
+        """A recorder capture of several axes; the result says how the recorders were armed."""
+        run = MultiRecorderCapture(plan, drive.engine.link, operational)
+        made = self.remember(run.run(report, cancellation, identity))
+        report({"stage": "captured", "capture": made})
+        assert run.armed is not None
+        return {"capture": made, "captures": 1, "bus": identity.bus, "node": identity.node, "arm": run.armed.method,
+                "alignment_ns": run.armed.alignment_ns, "arm_note": run.armed.note}  # fmt: skip
 
     def remember(self, made: Capture) -> str:
         """Keep a capture for the clients; returns its id (unguessable: ids name data of the machine)."""

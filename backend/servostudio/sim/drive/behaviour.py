@@ -59,6 +59,7 @@ from servostudio.sim.drive.statemachine import (
     STOP_CURRENT_LIMIT,
     STOP_QUICK_STOP_RAMP,
     STOP_SLOW_DOWN_RAMP,
+    Command,
     DeviceControl,
     Phase,
     State,
@@ -78,7 +79,7 @@ SUPERVISION_PERIODS = 4
 SLOW_PUBLISH_PERIODS = 32
 STANDSTILL_SPEED = 0.5  # rad/s: a stop has ended below this speed
 #: 0x60FD: the input functions (bits 0–15: limit switches, home, INHIBIT, …) and the INHIBIT bit
-INPUT_FUNCTIONS, INPUT_INHIBIT = 0xFFFF, 1 << 3
+INPUT_FUNCTIONS, INPUT_INHIBIT, INPUT_RESET, INPUT_QUICK_STOP = 0xFFFF, 1 << 3, 1 << 12, 1 << 15
 DEFAULT_DRIVE_RATED_CURRENT = 5.0
 """A, the smallest drive rating the simulated drives have (a larger motor gets a drive rated for its stall current)."""
 UNDERVOLTAGE_DEFAULTS = {400: 210, 230: 100, 48: 30, 34: 20, 17: 17}
@@ -138,6 +139,8 @@ class DriveBehaviour:
         #: 0x60FD function bits (0–15) the logic inputs give through their configuration (``sequencer/inputs.py``)
         self.routed_inputs = 0
         self._routed_inhibit = False
+        self._input_levels = 0  # 0x60FD functions at the last supervision: RESET and QUICK STOP act on edges
+        self.quick_stop_input = False
         self.position_offset_user = 0.0
         self.phasing_valid = plant.feedback != FEEDBACK_ENCODER  # an incremental encoder needs 'mcal' first
         self.max_speed = 1.0
@@ -537,7 +540,10 @@ class DriveBehaviour:
             handler.control_word(control_word, previous)
 
     def _can_enable(self) -> bool:
-        return self.phasing_valid and self.procedures.active is None and not self.inhibit_active
+        return (
+            self.phasing_valid and self.procedures.active is None and not self.inhibit_active
+            and not self.quick_stop_input
+        )  # fmt: skip
 
     def _run_loops_for_state(self) -> None:
         device_control = self.device_control
@@ -657,9 +663,11 @@ class DriveBehaviour:
 
     def _read_inputs(self) -> None:
         """The input functions of 0x60FD (bits 0–15) and what the drive does on them: a limit switch blocks its
-        direction, INHIBIT disables, the others only show (homing reads the plant's switches; docs/io.md)."""
+        direction, INHIBIT disables, RESET and QUICK STOP act on their edges, homing looks for the limit and home
+        switches here; ENABLE and motor phasing only show (docs/io.md)."""
         word, owned = self.input_word()
         self.negative_limit, self.positive_limit, self.home_switch = bool(word & 1), bool(word & 2), bool(word & 4)
+        self._act_on_edges(word)
         inhibit = bool(word & INPUT_INHIBIT)
         if inhibit != self._routed_inhibit:
             self._routed_inhibit = inhibit
@@ -669,6 +677,17 @@ class DriveBehaviour:
             if self.has("digital_inputs"):
                 current = int(self.p.get("digital_inputs", 0)) & ~owned
                 self.write("digital_inputs", current | word)
+
+    def _act_on_edges(self, word: int) -> None:
+        """RESET resets the faults whose cause has gone on its rising edge, as control word bit 7 does; QUICK STOP
+        quick-stops an enabled axis on its rising edge and keeps it from being enabled while active (manual §3.2.5.1:
+        the 0x60FD function bits 12 and 15)."""
+        rising, self._input_levels = word & ~self._input_levels, word
+        self.quick_stop_input = bool(word & INPUT_QUICK_STOP)
+        if rising & INPUT_RESET:
+            self._fault_reset()
+        if rising & INPUT_QUICK_STOP:
+            self.device_control.command(Command.QUICK_STOP, self._stop_options)
 
     def input_word(self) -> tuple[int, int]:
         """(the bits of 0x60FD this model sets, their mask): the plant's own limit and home switches, which act on

@@ -379,10 +379,10 @@ class HomingMode(ModeHandler):
         loops = drive.loops
         stalled_now = loops.current_limited and abs(loops.speed) < 0.2 * abs(self.ramp.velocity) + 0.05
         self._stall_time = self._stall_time + drive.dt if stalled_now else 0.0
-        inputs = HomingInputs(
-            negative_limit=physics.negative_limit_active(),
-            positive_limit=physics.positive_limit_active(),
-            home_switch=physics.home_switch_active(),
+        inputs = HomingInputs(  # the drive's input functions: the plant's switches and the inputs routed to them
+            negative_limit=drive.negative_limit,
+            positive_limit=drive.positive_limit,
+            home_switch=drive.home_switch,
             index_seen=physics.index_seen,
             index_position=drive.index_position_rad(),
             stalled=self._stall_time >= self.STALL_TIME,

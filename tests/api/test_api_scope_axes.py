@@ -1,0 +1,31 @@
+"""A recorder capture of two axes through the REST routes (docs/scope.md §8): the check states both axes' channels,
+the job arms both recorders with one broadcast frame and says so in its result, the capture joins both."""
+
+from __future__ import annotations
+
+from tests.api.test_api_scope import finished
+from tests.support.access import admin_app, api_client
+
+from servostudio.services.settings import Settings
+
+DEFINITION = {"channels": ["0x6064,0", "0x6041,0@2"], "samples": 100, "source": "recorder"}
+
+
+def test_a_two_axis_recorder_capture_job_says_how_it_was_armed(tmp_path, sim_opener):
+    app = admin_app(Settings(projects_dir=tmp_path, static_dir=tmp_path / "no-ui", buses=[]), tmp_path / "data")
+    with api_client(app) as client:
+        sim_opener(app.state.server.connections, "sim:1,2")
+        bus = app.state.server.connections.list()[0].id
+        scope = f"/api/buses/{bus}/nodes/1/scope"
+        plan = client.post(f"{scope}/check", json=DEFINITION).json()
+        assert plan["source"] == "recorder" and [c["key"] for c in plan["channels"]] == ["0x6064,0", "0x6041,0@2"]
+        job = finished(client, client.post(f"{scope}/captures", json=DEFINITION).json())
+        assert job["state"] == "done", job
+        result = job["result"]
+        assert result["arm"] == "broadcast" and result["alignment_ns"] == 250_000, result
+        made = client.get(f"{scope}/captures/{result['capture']}").json()
+        assert made["samples"] == 100 and made["alignment_ns"] == 250_000 and made["source"] == "recorder"
+        assert [channel["key"] for channel in made["channels"]] == ["0x6064,0", "0x6041,0@2"]
+        triggered = {**DEFINITION, "trigger": {"source": "0x6064,0", "edge": "rising", "level": 1}}
+        refused = client.post(f"{scope}/check", json=triggered)
+        assert refused.status_code == 422 and "immediate trigger" in refused.json()["detail"]
