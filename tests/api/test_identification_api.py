@@ -5,8 +5,8 @@ simulated axis's true plant."""
 from __future__ import annotations
 
 import pytest
-from tests.api.test_procedures_api import armed, finished
 from tests.support.access import admin_app, api_client
+from tests.support.jobs_api import armed, finished
 
 from servostudio.api.app import Settings
 from servostudio.sim.plant import Plant

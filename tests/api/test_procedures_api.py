@@ -4,12 +4,11 @@ cancelling the job, undo of an auto-tuning's gains."""
 
 from __future__ import annotations
 
-import contextlib
 import time
-from collections.abc import Iterator
 
 import pytest
 from tests.support.access import admin_app, api_client
+from tests.support.jobs_api import armed, finished
 
 from servostudio.api.app import Settings
 
@@ -26,27 +25,6 @@ def app(tmp_path_factory):
 def client(app):
     with api_client(app) as client:
         yield client
-
-
-@contextlib.contextmanager
-def armed(client) -> Iterator[tuple[object, dict[str, str]]]:
-    with client.websocket_connect("/api/ws/events?types=progress,job") as socket:
-        header = {"X-Servo-Client": socket.receive_json()["client"]}
-        assert client.post(f"{NODE}/control/arm", headers=header).status_code == 200
-        try:
-            yield socket, header
-        finally:
-            client.post(f"{NODE}/control/release", headers=header)
-
-
-def finished(client, job: str, timeout: float = 60.0) -> dict:
-    deadline = time.monotonic() + timeout
-    while time.monotonic() < deadline:
-        state = client.get(f"/api/jobs/{job}").json()
-        if state["state"] != "running":
-            return state
-        time.sleep(0.1)
-    raise AssertionError(f"job {job} still running")
 
 
 def test_the_list_names_every_procedure_with_its_preconditions(client):

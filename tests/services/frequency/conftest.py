@@ -9,10 +9,9 @@ from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field, replace
 
 import pytest
+from tests.support.axis_bench import AxisBench, connect
 
-from servostudio.drive.access import Drive
-from servostudio.services.audit import Actor, acting_as
-from servostudio.services.bus import BusConnection, ConnectionManager
+from servostudio.services.audit import acting_as
 from servostudio.services.cancel import Cancellation
 from servostudio.services.frequency.measure import MeasureRequest
 from servostudio.services.frequency.service import FrequencyRequest, FrequencyService
@@ -30,31 +29,8 @@ def free(plant: Plant) -> Plant:
 
 
 @dataclass
-class Bench:
-    connection: BusConnection
-    network: SimulatedNetwork
-    manager: ConnectionManager
+class Bench(AxisBench):
     service: FrequencyService = field(default_factory=FrequencyService)
-    _actor: Actor | None = None
-
-    @property
-    def axis(self) -> tuple[str, int]:
-        return (self.connection.id, 1)
-
-    def drive(self) -> Drive:
-        return self.connection.drive(1)
-
-    def plant(self) -> Plant:
-        """The hidden truth (the service never sees it)."""
-        with self.network.lock:
-            return self.network.node(1).behaviour.plant  # type: ignore[attr-defined]
-
-    def controller(self) -> Actor:
-        if self._actor is None:
-            guard = self.manager.motion
-            self._actor = Actor("tests", "administrator", guard.connect("tests"))
-            guard.arm(self._actor, self.axis)
-        return self._actor
 
     def measure(self, cancellation: Cancellation | None = None, **options: object) -> dict:
         request = FrequencyRequest(MeasureRequest(**options))  # type: ignore[arg-type]
@@ -75,11 +51,7 @@ def open_bench(plant: Plant, speed: float) -> Bench:
         "1", behaviour_factory=lambda device, node, store, events: make_behaviour(device, store, plant, events, True)
     )
     network.start(speed)
-    manager = ConnectionManager()
-    manager._opener = lambda spec: (network.open_bus, network)  # type: ignore[method-assign]
-    connection = manager.open("sim", wait=5.0)
-    assert connection.link.wait_connected(5.0)
-    connection.engine.timeout = SDO_TIMEOUT
+    manager, connection = connect(network, SDO_TIMEOUT)
     return Bench(connection, network, manager)
 
 

@@ -9,11 +9,10 @@ from collections.abc import Iterator
 from dataclasses import dataclass, replace
 
 import pytest
+from tests.support.axis_bench import AxisBench, connect
 from tests.support.embedded_sim import SDO_TIMEOUT
 
-from servostudio.drive.access import Drive
-from servostudio.services.audit import Actor, acting_as
-from servostudio.services.bus import BusConnection, ConnectionManager
+from servostudio.services.audit import acting_as
 from servostudio.services.cancel import Cancellation
 from servostudio.services.identification import IdentificationRequest, check, identify
 from servostudio.sim.drive import make_behaviour
@@ -28,29 +27,8 @@ def hidden_plant(seed: int) -> Plant:
 
 
 @dataclass
-class IdBench:
-    connection: BusConnection
-    network: SimulatedNetwork
-    manager: ConnectionManager
-    actor: Actor | None = None
-
-    @property
-    def axis(self) -> tuple[str, int]:
-        return (self.connection.id, 1)
-
-    def drive(self) -> Drive:
-        return self.connection.drive(1)
-
-    def plant(self) -> Plant:
-        with self.network.lock:
-            return self.network.node(1).behaviour.plant  # type: ignore[attr-defined]
-
-    def controller(self) -> Actor:
-        if self.actor is None:
-            guard = self.manager.motion
-            self.actor = Actor("tests", "expert", guard.connect("tests"))
-            guard.arm(self.actor, self.axis)
-        return self.actor
+class IdBench(AxisBench):
+    level = "expert"
 
     def identify(self, options: dict | None = None, events: list | None = None) -> dict:
         """The identification as a job runs it, acting as the axis's armed controller."""
@@ -66,12 +44,8 @@ def open_id_bench(device: str, seed: int) -> IdBench:
         return make_behaviour(kind, store, hidden_plant(seed), events, kind != "encotrive")
 
     network = SimulatedNetwork(f"1:{device}", behaviour_factory=factory)
-    manager = ConnectionManager()
-    manager._opener = lambda spec: ((lambda: network.open_bus()), network)  # type: ignore[method-assign]
-    connection = manager.open("sim", wait=5.0)
     network.start()
-    assert connection.link.wait_connected(5.0)
-    connection.engine.timeout = SDO_TIMEOUT
+    manager, connection = connect(network, SDO_TIMEOUT)
     return IdBench(connection, network, manager)
 
 
