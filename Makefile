@@ -28,7 +28,7 @@ $(VENV)/.stamp-install: pyproject.toml
 	touch $@
 
 $(VENV)/.stamp-install-test: $(VENV)/.stamp-install
-	$(BIN)/pip install --quiet -e '.[test]'
+	$(BIN)/pip install --quiet -e '.[test,profibus]'
 	touch $@
 
 frontend/node_modules/.stamp: frontend/package.json frontend/package-lock.json

@@ -1,8 +1,9 @@
 """The dependencies in `pyproject.toml` tell the truth: a runtime dependency is one the running product imports.
 
 A package only tests or benchmarks use (`canopen`, the independent CANopen peer) belongs to the `test` or `bench`
-extra, and one nothing imports yet (`plotly`, until the oscilloscope) to no list at all. Imports are read with `ast`
-(inside functions too) and mapped to distributions through the installed packages' metadata.
+extra, and one nothing imports yet (`plotly`, until the oscilloscope) to no list at all. A product extra (`profibus`:
+pyprofibus, GPL) is imported by the product only where it is needed, and the core runs without it. Imports are read
+with `ast` (inside functions too) and mapped to distributions through the installed packages' metadata.
 """
 
 from __future__ import annotations
@@ -22,6 +23,8 @@ PYPROJECT = tomllib.loads((REPO / "pyproject.toml").read_text(encoding="utf-8"))
 #: Runtime dependencies the product needs without importing them itself, and why.
 NOT_IMPORTED = {"python-multipart": "FastAPI parses the EDS upload route's File fields with it"}
 OWN_MODULES = {"servostudio", "tests", "conftest"}
+#: extras of the product itself (not of its tests): imported by the product, installed on demand
+PRODUCT_EXTRAS = ("profibus",)
 
 
 def distribution(requirement: str) -> str:
@@ -68,8 +71,26 @@ def test_every_runtime_dependency_is_imported_by_the_product() -> None:
 
 
 def test_everything_the_product_imports_is_a_runtime_dependency() -> None:
-    missing = imported_distributions(REPO / "backend" / "servostudio") - declared()
+    missing = imported_distributions(REPO / "backend" / "servostudio") - declared(*PRODUCT_EXTRAS)
     assert not missing, f"the product imports these, but [project] dependencies do not list them: {sorted(missing)}"
+
+
+def test_the_gpl_master_is_an_optional_extra_imported_only_for_a_serial_line() -> None:
+    """pyprofibus (GPL-2.0-or-later) stays out of the core: only its adapter imports it at module level, and the
+    opener imports the adapter inside the function that opens a serial PROFIBUS line (README "Licence")."""
+    assert "pyprofibus" not in declared() and "pyprofibus" in declared("profibus")
+    backend = REPO / "backend" / "servostudio"
+    importers = sorted(
+        str(path.relative_to(backend)) for path in backend.rglob("*.py") if "pyprofibus" in imported_top_names_of(path)
+    )
+    assert importers == ["transport/profibus/pyprofibus_master.py"]
+
+
+def imported_top_names_of(path: Path) -> set[str]:
+    """The top-level names a file imports at module level."""
+    tree = ast.parse(path.read_text(encoding="utf-8"), filename=str(path))
+    names = {alias.name.split(".")[0] for node in tree.body if isinstance(node, ast.Import) for alias in node.names}
+    return names | {node.module.split(".")[0] for node in tree.body if isinstance(node, ast.ImportFrom) and node.module}
 
 
 @pytest.mark.parametrize("folder, extra", [("tests", "test"), ("bench", "bench")])

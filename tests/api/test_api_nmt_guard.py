@@ -8,6 +8,7 @@ import time
 
 import pytest
 from tests.support.access import admin_app, api_client
+from tests.support.jobs_api import armed, finished
 
 from servostudio.api.app import Settings
 from servostudio.services.users import Level
@@ -65,11 +66,31 @@ def test_nmt_start_of_an_enabled_axis_needs_its_controller(app):
         assert results.index(("start", "ok")) > results.index(("start", "refused"))
 
 
+def test_the_servers_own_nmt_start_for_a_tpdo_capture_is_judged_as_the_routes(app):
+    """A TPDO capture starts a PRE-OPERATIONAL node itself: on an enabled axis that hands the axis to its RPDOs, so
+    only the axis's controller's capture may; anyone else's fails before the frame is sent, and both are logged."""
+    capture = {"channels": ["0x606C,0"], "period_us": 1000, "samples": 50, "source": "tpdo"}
+    with api_client(app) as client, armed(client) as (_socket, holder):
+        assert client.post("/api/buses/sim/nmt", json={"command": "pre-operational", "node": 1}).status_code == 204
+        enabled = client.put(f"{NODE}/state", json={"target": "operation-enabled"}, headers=holder)
+        assert enabled.json()["state"] == "OPERATION ENABLED", enabled.text
+        try:
+            refused = finished(client, client.post(f"{NODE}/scope/captures", json=capture).json()["id"])
+            assert refused["state"] == "failed" and "NMT start of node 1" in refused["error"], refused
+            made = finished(client, client.post(f"{NODE}/scope/captures", json=capture, headers=holder).json()["id"])
+            assert made["state"] == "done", made
+        finally:
+            client.put(f"{NODE}/state", json={"target": "switch-on-disabled"}, headers=holder)
+        results = [(entry["new"], entry["result"]) for entry in reversed(_nmt_entries(client))]
+        assert results[-3:] == [("start", "refused"), ("start", "ok"), ("pre-operational", "ok")], results
+
+
 def test_server_settings_for_administrators_only(app):
     with api_client(app) as client:
         shown = client.get("/api/server/settings").json()
         assert shown["buses"] == ["sim"] and shown["host"] == "127.0.0.1"
         assert shown["projects_dir"].endswith("projects") and shown["passwordless"] is False
+        assert shown["audit_old_values"] == "small-writes"  # a restore logs old: null unless asked otherwise
         assert not any(word in str(shown.values()).lower() for word in ("hash", "argon", "token", "secret"))
         expert = api_client(app, Level.EXPERT)  # not entered: that would start the app a second time
         assert expert.get("/api/server/settings").status_code == 403

@@ -91,6 +91,11 @@ def test_cd1k_dedicated_limit_switch(page: Page, demo_server: DemoServer, io_pro
     expect(limit).to_have_class(ON)
     page.get_by_test_id("io-bench-INPUT0").uncheck()
     expect(limit).not_to_have_class(ON)
+    page.get_by_test_id("tab-dashboard").click()  # its terminals named once each, from the I/O configuration,
+    terminals = page.get_by_test_id("io-inputs").locator(".led")  # apart from what the drive makes of them
+    expect(terminals).to_have_text(["INPUT0 LIM+", "INPUT1 LIM−", "INHIBIT", "INPUT3 INDEX", "INPUT4 CAPTURE",
+                                    "INPUT5 LOW"])  # fmt: skip
+    expect(page.get_by_test_id("io-inputs-functions").locator(".led")).to_have_text(["LIM−", "LIM+", "Home", "Inhibit"])
 
 
 def test_encotrive_shows_its_inputs_without_configuration(page: Page, demo_server: DemoServer, io_project: str):

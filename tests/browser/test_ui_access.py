@@ -73,11 +73,13 @@ def test_an_operator_logs_in_and_is_refused_a_write(page: Page, server) -> None:
 
 
 def test_logging_out_ends_the_session(page: Page, server) -> None:
+    # a user of its own: the setup test's admin may live on another worker's server (pytest-xdist)
+    UserStore(server.data_dir).add_user("lena", Level.ADMINISTRATOR, PASSWORD)
     page.goto(server.url + "/login")
-    page.get_by_test_id("login-name").fill("admin")
+    page.get_by_test_id("login-name").fill("lena")
     page.get_by_test_id("login-password").fill(PASSWORD)
     page.get_by_test_id("login-submit").click()
-    expect(page.get_by_test_id("user-status")).to_contain_text("admin · administrator")
+    expect(page.get_by_test_id("user-status")).to_contain_text("lena · administrator")
     page.get_by_test_id("log-out").click()
     expect(page).to_have_url(re.compile(r"/login"))
     page.goto(server.url + "/")

@@ -13,9 +13,8 @@ import sys
 
 import httpx
 import pytest
+from tests.cli.conftest import run
 from tests.support.motion_timing import InProcessServer
-
-from servostudio.cli import main
 
 QUICK = ("--periods", "2", "--base-speed", "10", "--window", "20")
 
@@ -23,12 +22,6 @@ QUICK = ("--periods", "2", "--base-speed", "10", "--window", "20")
 @pytest.fixture(autouse=True)
 def data_dir(tmp_path, monkeypatch):
     monkeypatch.setenv("SERVOSTUDIO_DATA_DIR", str(tmp_path / "data"))
-
-
-def run(capsys, *argv: str) -> tuple[int, str, str]:
-    code = main(list(argv))
-    captured = capsys.readouterr()
-    return code, captured.out, captured.err
 
 
 def rows(path) -> list[dict[str, str]]:
@@ -68,6 +61,19 @@ def test_bode_writes_the_pinned_csv(capsys, tmp_path):
     assert len(table) == summary["points"] == summary["excitation"]["points"]
     assert float(table[0]["freq_hz"]) == pytest.approx(5.0, rel=0.01)
     assert "# magnitude: dB of (velocity in rad/s) / (torque in N*m)" in out.read_text(encoding="utf-8")
+
+
+def test_bode_on_a_drive_without_a_recorder_measures_through_tpdos(capsys, tmp_path):
+    """The CD1-k: the same command and CSV; the response came in synchronous TPDOs, the plant per ampere (the drive
+    gives no torque constant)."""
+    out = tmp_path / "cd1k.csv"
+    code, printed, err = run(capsys, "bode", "--bus", "sim:1:cd1k", "--node", "1", "--loop", "plant", "--to", "200",
+                             *QUICK, "--yes", "--out", str(out))  # fmt: skip
+    assert code == 0, err
+    summary = json.loads(printed)
+    assert summary["aborted"] is None and summary["excitation"]["source"] == "tpdo"
+    assert list(rows(out)[0]) == ["freq_hz", "magnitude_db", "phase_deg", "coherence"]
+    assert "# magnitude: dB of (velocity in rad/s) / (current in A)" in out.read_text(encoding="utf-8")
 
 
 def test_without_yes_nothing_turns_and_a_bad_request_is_refused(capsys, tmp_path):

@@ -4,10 +4,12 @@ traceback and exit code 70. Run in-process through `main(argv)`, on the in-proce
 
 from __future__ import annotations
 
+import argparse
+
 import pytest
 
+from servostudio.cli import build_parser, main
 from servostudio.cli import drive as drive_commands
-from servostudio.cli import main
 from servostudio.errors import OUTCOMES, ErrorKind
 
 
@@ -80,3 +82,14 @@ def test_a_bug_exits_70_with_its_traceback(capsys, monkeypatch):
 def test_refused_nmt_is_invalid_input_not_a_bug(capsys, argv):
     code, error = run(capsys, *argv)
     assert code == 3 and "Traceback" not in error
+
+
+def test_every_command_prints_its_help(capsys):
+    """``servostudio COMMAND --help`` answers for every command (a ``%`` in a help text once broke two of them)."""
+    parser = build_parser()
+    commands = next(action for action in parser._actions if isinstance(action, argparse._SubParsersAction))
+    for name in commands.choices:
+        with pytest.raises(SystemExit) as ended:
+            main([name, "--help"])
+        assert ended.value.code == 0, name
+        assert "usage: servostudio" in capsys.readouterr().out, name

@@ -4,13 +4,9 @@ written."""
 
 from __future__ import annotations
 
-import json
-
 import pytest
+from tests.cli.conftest import run_json
 from tests.support.live_server import LiveServer
-
-from servostudio.cli import main
-from servostudio.cli.remote import CONFIG_VARIABLE, SERVER_VARIABLE
 
 
 @pytest.fixture(scope="module")
@@ -25,45 +21,33 @@ def server(socketcand, tmp_path_factory):
         live.stop()
 
 
-@pytest.fixture(autouse=True)
-def no_default_server(monkeypatch, tmp_path):
-    monkeypatch.delenv(SERVER_VARIABLE, raising=False)
-    monkeypatch.setenv(CONFIG_VARIABLE, str(tmp_path / "absent.toml"))
-
-
-def run(capsys, *argv: str) -> tuple[int, object, str]:
-    code = main(list(argv))
-    captured = capsys.readouterr()
-    return code, json.loads(captured.out) if captured.out.strip() else None, captured.err
-
-
 def row(configuration, name: str) -> dict:
     return next(item for item in configuration["inputs"] if item["name"] == name)
 
 
 def test_io_shows_and_changes_a_limit_switch_here_and_through_the_server(server, socketcand, capsys):
     here = ("--bus", socketcand.spec, "--node", "1")
-    code, changed, _ = run(capsys, "io", *here, "--input", "IN3=positive_limit:inverted")
+    code, changed, _ = run_json(capsys, "io", *here, "--input", "IN3=positive_limit:inverted")
     try:
         assert code == 0 and changed["written"] == ["0x3051,0", "0x3050,3"]
-        code, through, _ = run(capsys, "io", "--server", server.url, "--node", "1")
+        code, through, _ = run_json(capsys, "io", "--server", server.url, "--node", "1")
         assert code == 0 and (row(through, "IN3")["function"], row(through, "IN3")["inverted"]) == (
             "positive_limit",
             True,
         )
-        code, _, _ = run(capsys, "io", "--server", server.url, "--node", "1", "--input", "IN3=:normal")
+        code, _, _ = run_json(capsys, "io", "--server", server.url, "--node", "1", "--input", "IN3=:normal")
         assert code == 0
-        code, shown, _ = run(capsys, "read", *here, "0x3051,0")
+        code, shown, _ = run_json(capsys, "read", *here, "0x3051,0")
         assert code == 0 and not int(shown["raw"]) & 0b100  # IN3's polarity bit, read back from the drive
     finally:
-        run(capsys, "io", *here, "--input", "IN3=none:normal")
+        run_json(capsys, "io", *here, "--input", "IN3=none:normal")
 
 
 def test_a_refused_change_or_a_bad_option_exits_3_and_writes_nothing(socketcand, capsys):
     here = ("--bus", socketcand.spec, "--node", "1")
-    _, before, _ = run(capsys, "read", *here, "0x3050,4", "0x3050,5")
-    code, _, error = run(capsys, "io", *here, "--input", "IN4=home", "--input", "IN5=home")
+    _, before, _ = run_json(capsys, "read", *here, "0x3050,4", "0x3050,5")
+    code, _, error = run_json(capsys, "io", *here, "--input", "IN4=home", "--input", "IN5=home")
     assert code == 3 and "IN4 and IN5 would both be 'home'" in error
-    code, _, error = run(capsys, "io", *here, "--input", "IN4")
+    code, _, error = run_json(capsys, "io", *here, "--input", "IN4")
     assert code == 3 and "NAME=FUNCTION" in error
-    assert run(capsys, "read", *here, "0x3050,4", "0x3050,5")[1] == before
+    assert run_json(capsys, "read", *here, "0x3050,4", "0x3050,5")[1] == before

@@ -11,8 +11,8 @@ import io
 import json
 
 import pytest
+from tests.cli.conftest import run
 
-from servostudio.cli import main
 from servostudio.drive.cia402 import State
 from servostudio.drive.control import read_state, set_state
 from servostudio.services.bus import ConnectionManager
@@ -36,12 +36,6 @@ def switched_on(socketcand):
     yield lambda: read_state(drive)[0]
     set_state(drive, State.SWITCH_ON_DISABLED)
     manager.close_all()
-
-
-def run(capsys, *argv: str) -> tuple[int, str, str]:
-    code = main(list(argv))
-    captured = capsys.readouterr()
-    return code, captured.out, captured.err
 
 
 @pytest.mark.parametrize("value", ["15", "15.0", "1.5e1", "0x8F"])

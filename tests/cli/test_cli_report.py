@@ -5,14 +5,11 @@ atomically and a refusal leaves the previous one whole."""
 
 from __future__ import annotations
 
-import json
-
 import pytest
+from tests.cli.conftest import run_json
 from tests.services.report.support import PLANT_FIT, Page, commissioned, plotted
 from tests.support.live_server import LiveServer
 
-from servostudio.cli import main
-from servostudio.cli.remote import CONFIG_VARIABLE, SERVER_VARIABLE
 from servostudio.services.audit import AuditLog
 
 
@@ -38,23 +35,15 @@ def server(store):
 
 
 @pytest.fixture(autouse=True)
-def no_default_server(monkeypatch, tmp_path):
-    """Neither the developer's environment nor their config file may choose a server (or data directory) here."""
-    monkeypatch.delenv(SERVER_VARIABLE, raising=False)
-    monkeypatch.setenv(CONFIG_VARIABLE, str(tmp_path / "absent.toml"))
+def no_data_dir(monkeypatch, tmp_path):
+    """Nor may the developer's data directory (users, tokens) reach the report commands."""
     monkeypatch.setenv("SERVOSTUDIO_DATA_DIR", str(tmp_path / "no-data"))
-
-
-def run(capsys, *argv: str) -> tuple[int, dict | None, str]:
-    code = main(list(argv))
-    captured = capsys.readouterr()
-    return code, json.loads(captured.out) if captured.out.strip() else None, captured.err
 
 
 def test_the_project_report_is_written_offline_from_the_project_directory(store, tmp_path, capsys):
     root, record = store
     out = tmp_path / "demo.html"
-    code, summary, _ = run(capsys, "report", "demo", "--out", str(out), "--projects", str(root / "projects"),
+    code, summary, _ = run_json(capsys, "report", "demo", "--out", str(out), "--projects", str(root / "projects"),
                            "--data-dir", str(root / "data"))  # fmt: skip
     assert code == 0 and summary["out"] == str(out) and summary["bytes"] == out.stat().st_size
     html = out.read_text(encoding="utf-8")
@@ -73,33 +62,33 @@ def test_an_axis_report_replaces_the_file_and_a_refusal_leaves_it_whole(store, t
     out = tmp_path / "x.html"
     out.write_text("old")
     projects = ("--projects", str(root / "projects"))
-    code, summary, _ = run(capsys, "report", "demo", "X", "--out", str(out), *projects)
+    code, summary, _ = run_json(capsys, "report", "demo", "X", "--out", str(out), *projects)
     assert code == 0 and summary["axis"] == "X"
     text = " ".join(Page(out.read_text(encoding="utf-8")).text)
     assert "Axis X" in text and "Axis Y" not in text
     assert "No audit log at hand" in text  # no data directory with an audit log here
     before = out.read_bytes()
-    code, _, error = run(capsys, "report", "demo", "Q", "--out", str(out), *projects)
+    code, _, error = run_json(capsys, "report", "demo", "Q", "--out", str(out), *projects)
     assert code == 4 and "no axis 'Q'" in error
     assert out.read_bytes() == before and sorted(path.name for path in tmp_path.glob("*.html*")) == ["x.html"]
-    code, _, error = run(capsys, "report", "demo", "--out", str(tmp_path / "absent" / "r.html"), *projects)
+    code, _, error = run_json(capsys, "report", "demo", "--out", str(tmp_path / "absent" / "r.html"), *projects)
     assert code == 3 and "does not exist" in error
 
 
 def test_through_the_server_the_report_is_the_servers(store, server, tmp_path, capsys):
     _, record = store
     out = tmp_path / "served.html"
-    code, summary, _ = run(capsys, "report", "demo", "X", "--out", str(out), "--server", server.url)
+    code, summary, _ = run_json(capsys, "report", "demo", "X", "--out", str(out), "--server", server.url)
     assert code == 0 and summary["from"] == f"server {server.url}"
     html = out.read_text(encoding="utf-8")
     assert "Axis X" in " ".join(Page(html).text)
     step = record.tuning["verification"]["speed_step"]["capture"]
     assert plotted(html, "axis-1-steps-0-speed_step")[1]["y"] == step["response"]
-    code, _, error = run(capsys, "report", "demo", "Q", "--out", str(out), "--server", server.url)
+    code, _, error = run_json(capsys, "report", "demo", "Q", "--out", str(out), "--server", server.url)
     assert code == 4 and "no axis 'Q'" in error
 
 
 def test_an_unreachable_server_writes_nothing(tmp_path, capsys):
     out = tmp_path / "none.html"
-    code, _, error = run(capsys, "report", "demo", "--out", str(out), "--server", "http://127.0.0.1:9")
+    code, _, error = run_json(capsys, "report", "demo", "--out", str(out), "--server", "http://127.0.0.1:9")
     assert code == 5 and "cannot be reached" in error and not out.exists()

@@ -3,26 +3,19 @@ supported drive (the CD1-k has no 0x603F)."""
 
 from __future__ import annotations
 
-import json
 from types import SimpleNamespace
 
 import pytest
+from tests.cli.conftest import run_json
 
-from servostudio.cli import main
 from servostudio.errors import OUTCOMES, ErrorKind
 from servostudio.services.bus import ConnectionManager
 from servostudio.services.scan import empty_scan_hint, scan
 from servostudio.transport.spec import parse_bus_spec
 
 
-def run(capsys, *argv: str) -> tuple[int, object, str]:
-    code = main(list(argv))
-    captured = capsys.readouterr()
-    return code, json.loads(captured.out) if captured.out.strip() else None, captured.err
-
-
 def test_a_scan_of_an_empty_virtual_channel_fails_and_says_why(capsys):
-    code, nodes, error = run(capsys, "scan", "--bus", "virtual:empty-channel-of-this-test")
+    code, nodes, error = run_json(capsys, "scan", "--bus", "virtual:empty-channel-of-this-test")
     assert code == OUTCOMES[ErrorKind.NOT_FOUND].exit_code == 4
     assert nodes == []
     assert "no node answered on virtual:empty-channel-of-this-test" in error
@@ -57,6 +50,6 @@ def test_the_empty_scan_event_carries_the_hint():
 
 def test_fault_works_on_a_cd1k_and_an_encotrive(capsys):
     for node in (7, 9):
-        code, report, error = run(capsys, "fault", "--bus", "sim:7:cd1k,9:encotrive", "--node", str(node))
+        code, report, error = run_json(capsys, "fault", "--bus", "sim:7:cd1k,9:encotrive", "--node", str(node))
         assert code == 0, error
         assert report["node"] == node and report["faults"] == [] and report["causes"] == []

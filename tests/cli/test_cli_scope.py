@@ -184,3 +184,15 @@ def test_a_cd1k_capture_through_tpdos_with_a_second_axis(tmp_path, capsys):
     assert "# source: tpdo" in text and 'time_s,"0x6041,0","0x6041,0@1"' in text
     rows = list(csv.reader(line for line in text.splitlines() if not line.startswith("# ")))
     assert len(rows) == 51 and [row[0] for row in rows[1:3]] == ["0", "0.001"]
+
+
+def test_a_two_axis_recorder_capture_summary_says_how_it_was_armed(tmp_path, capsys):
+    out = tmp_path / "axes.csv"
+    code = main(["scope", "--bus", "sim:1,2", "--node", "1", "--ch", "0x6064,0", "--ch", "0x6064,0@2", "--source",
+                 "recorder", "--samples", "50", "--out", str(out)])  # fmt: skip
+    assert code == 0, capsys.readouterr().err
+    summary = json.loads(capsys.readouterr().out)
+    assert summary["arm"] == "broadcast" and "one broadcast frame armed every recorder" in summary["arm_note"]
+    assert summary["alignment_ns"] == 250_000 and summary["channels"] == ["0x6064,0", "0x6064,0@2"]
+    single = main(["scope", "--bus", "sim:1", "--node", "1", "--ch", "0x6064,0", "--samples", "20", "--out", str(out)])
+    assert single == 0 and json.loads(capsys.readouterr().out)["arm"] is None  # one drive: nothing to say

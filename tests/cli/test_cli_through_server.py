@@ -14,6 +14,7 @@ import sys
 import time
 
 import pytest
+from tests.cli.conftest import run_json
 from tests.support.live_server import LiveServer
 
 from servostudio.cli import main
@@ -32,35 +33,22 @@ def server(socketcand, tmp_path_factory):
         live.stop()
 
 
-@pytest.fixture(autouse=True)
-def no_default_server(monkeypatch, tmp_path):
-    """Neither the developer's environment nor their config file may choose a server for these tests."""
-    monkeypatch.delenv(SERVER_VARIABLE, raising=False)
-    monkeypatch.setenv(CONFIG_VARIABLE, str(tmp_path / "absent.toml"))
-
-
-def run(capsys, *argv: str) -> tuple[int, object, str]:
-    code = main(list(argv))
-    captured = capsys.readouterr()
-    return code, json.loads(captured.out) if captured.out.strip() else None, captured.err
-
-
 def test_read_and_write_through_the_server_answer_as_the_drive_itself(server, socketcand, capsys):
-    code, written, _ = run(capsys, "write", "--server", server.url, "--node", "1", "0x60F9,2", "123")
+    code, written, _ = run_json(capsys, "write", "--server", server.url, "--node", "1", "0x60F9,2", "123")
     assert code == 0 and written["raw"] == 123
-    here = run(capsys, "read", "--bus", socketcand.spec, "--node", "1", "0x60F9,2", "statusword")
-    through = run(capsys, "read", "--server", server.url, "--node", "1", "0x60F9,2", "statusword")
+    here = run_json(capsys, "read", "--bus", socketcand.spec, "--node", "1", "0x60F9,2", "statusword")
+    through = run_json(capsys, "read", "--server", server.url, "--node", "1", "0x60F9,2", "statusword")
     assert through == here and here[1][0]["raw"] == 123
 
 
 def test_the_default_server_comes_from_the_environment_and_bus_stays_headless(server, socketcand, capsys, monkeypatch):
     monkeypatch.setenv(SERVER_VARIABLE, server.url)
-    code, value, _ = run(capsys, "read", "--node", "2", "0x6041")
+    code, value, _ = run_json(capsys, "read", "--node", "2", "0x6041")
     assert code == 0 and value["index"] == 0x6041
     monkeypatch.setenv(SERVER_VARIABLE, "http://127.0.0.1:9")  # nobody listens there: --bus must not go there
-    code, value, _ = run(capsys, "read", "--bus", socketcand.spec, "--node", "2", "0x6041")
+    code, value, _ = run_json(capsys, "read", "--bus", socketcand.spec, "--node", "2", "0x6041")
     assert code == 0 and value["index"] == 0x6041
-    code, _, error = run(capsys, "read", "--node", "2", "0x6041")
+    code, _, error = run_json(capsys, "read", "--node", "2", "0x6041")
     assert code == 5 and "cannot be reached" in error
 
 
@@ -68,60 +56,62 @@ def test_the_default_server_comes_from_the_config_file(server, capsys, monkeypat
     config = tmp_path / "config.toml"
     config.write_text(f'server = "{server.url}"\n', encoding="utf-8")
     monkeypatch.setenv(CONFIG_VARIABLE, str(config))
-    code, nodes, _ = run(capsys, "scan")
+    code, nodes, _ = run_json(capsys, "scan")
     assert code == 0 and [node["node"] for node in nodes] == [1, 2, 3]
 
 
 def test_bus_names_the_servers_bus_by_name_or_by_any_spelling_of_its_spec(server, socketcand, capsys):
     for bus in ("socketcand", f"{socketcand.spec}/can0", socketcand.spec):
-        code, value, _ = run(capsys, "read", "--server", server.url, "--bus", bus, "--node", "3", "0x6041")
+        code, value, _ = run_json(capsys, "read", "--server", server.url, "--bus", bus, "--node", "3", "0x6041")
         assert code == 0 and value["node"] == 3
-    code, _, error = run(capsys, "read", "--server", server.url, "--bus", "virtual:other", "--node", "3", "0x6041")
+    code, _, error = run_json(capsys, "read", "--server", server.url, "--bus", "virtual:other", "--node", "3", "0x6041")
     assert code == 4 and "has no bus 'virtual:other' open (open: socketcand)" in error
 
 
 def test_exit_codes_are_the_servers_kinds(server, capsys):
-    assert run(capsys, "read", "--server", server.url, "--node", "1", "0x2FFE")[0] == 4  # not in the dictionary
-    assert run(capsys, "write", "--server", server.url, "--node", "1", "0x6041", "1")[0] == 3  # read-only
-    assert run(capsys, "read", "--server", server.url, "--node", "44", "0x6041")[0] == 4  # no such node
-    assert run(capsys, "nmt", "--server", server.url, "sing")[0] == 3  # refused before the server is asked
-    code, answer, _ = run(capsys, "nmt", "--server", server.url, "pre-operational", "--node", "3")
+    assert run_json(capsys, "read", "--server", server.url, "--node", "1", "0x2FFE")[0] == 4  # not in the dictionary
+    assert run_json(capsys, "write", "--server", server.url, "--node", "1", "0x6041", "1")[0] == 3  # read-only
+    assert run_json(capsys, "read", "--server", server.url, "--node", "44", "0x6041")[0] == 4  # no such node
+    assert run_json(capsys, "nmt", "--server", server.url, "sing")[0] == 3  # refused before the server is asked
+    code, answer, _ = run_json(capsys, "nmt", "--server", server.url, "pre-operational", "--node", "3")
     assert (code, answer) == (0, {"command": "pre-operational", "node": 3})
 
 
 def test_backup_and_restore_keep_the_files_here_and_reach_the_servers_drive(server, socketcand, capsys, tmp_path):
     here, through = tmp_path / "here.DRIVEPAR.TXT", tmp_path / "through.DRIVEPAR.TXT"
-    code, result, _ = run(capsys, "backup", "--server", server.url, "--node", "2", "--out", str(through))
+    code, result, _ = run_json(capsys, "backup", "--server", server.url, "--node", "2", "--out", str(through))
     assert code == 0 and result["file"] == str(through) and result["objects"] > 300
-    code, local, _ = run(capsys, "backup", "--bus", socketcand.spec, "--node", "2", "--out", str(here))
+    code, local, _ = run_json(capsys, "backup", "--bus", socketcand.spec, "--node", "2", "--out", str(here))
     assert code == 0 and _entries(through) == _entries(here)
     assert {key: result[key] for key in ("objects", "skipped", "kind")} == {
         key: local[key] for key in ("objects", "skipped", "kind")
     }
     through.write_text(_set(through, "0x60F9,2", 77), encoding="latin-1")
-    code, restored, _ = run(
+    code, restored, _ = run_json(
         capsys, "restore", "--server", server.url, "--node", "2", "--in", str(through), "--no-store"
     )
     assert code == 0 and restored["ok"] and restored["file"] == str(through) and restored["stored"] == ""
-    assert run(capsys, "read", "--bus", socketcand.spec, "--node", "2", "0x60F9,2")[1]["raw"] == 77
+    assert run_json(capsys, "read", "--bus", socketcand.spec, "--node", "2", "0x60F9,2")[1]["raw"] == 77
     through.write_text("0x60F9,2=70000\n", encoding="latin-1")  # out of range: refused, nothing written
-    code, _, error = run(capsys, "restore", "--server", server.url, "--node", "2", "--in", str(through))
+    code, _, error = run_json(capsys, "restore", "--server", server.url, "--node", "2", "--in", str(through))
     assert code == 3 and "DRIVEPAR.TXT:1" in error
-    assert run(capsys, "read", "--bus", socketcand.spec, "--node", "2", "0x60F9,2")[1]["raw"] == 77
+    assert run_json(capsys, "read", "--bus", socketcand.spec, "--node", "2", "0x60F9,2")[1]["raw"] == 77
 
 
 def test_backup_of_every_node_into_a_directory(server, capsys, tmp_path):
-    code, results, _ = run(capsys, "backup", "--server", server.url, "--out", str(tmp_path / "all"))
+    code, results, _ = run_json(capsys, "backup", "--server", server.url, "--out", str(tmp_path / "all"))
     assert code == 0 and sorted(results) == ["1", "2", "3"]
     assert all((tmp_path / "all" / f"node{node}" / "DRIVEPAR.TXT").is_file() for node in (1, 2, 3))
-    code, restored, _ = run(capsys, "restore", "--server", server.url, "--node", "3", "--in", str(tmp_path / "all"))
+    code, restored, _ = run_json(
+        capsys, "restore", "--server", server.url, "--node", "3", "--in", str(tmp_path / "all")
+    )
     assert code == 0 and all(item["ok"] for item in restored["3"])
 
 
 def test_share_gives_the_servers_bus_to_canopen_and_off_ends_it(server, capsys):
     import canopen
 
-    code, shared, _ = run(capsys, "share", "--server", server.url)
+    code, shared, _ = run_json(capsys, "share", "--server", server.url)
     assert code == 0 and shared["bus"] == "socketcand" and shared["port"] > 0
     network = canopen.Network()
     network.connect(interface="socketcand", channel="can0", host="127.0.0.1", port=shared["port"])
@@ -129,8 +119,8 @@ def test_share_gives_the_servers_bus_to_canopen_and_off_ends_it(server, capsys):
         assert network.add_node(1, canopen.ObjectDictionary()).sdo.upload(0x1008, 0) == b"XtrapulsPac"
     finally:
         network.disconnect()
-    assert run(capsys, "share", "--server", server.url, "--off")[1] == {"bus": "socketcand", "shared": False}
-    assert run(capsys, "share", "--bus", "sim")[0] == 3  # a bus of this process is not shared
+    assert run_json(capsys, "share", "--server", server.url, "--off")[1] == {"bus": "socketcand", "shared": False}
+    assert run_json(capsys, "share", "--bus", "sim")[0] == 3  # a bus of this process is not shared
 
 
 def test_enabling_through_the_server_holds_until_interrupted_then_stops(server, socketcand):

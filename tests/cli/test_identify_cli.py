@@ -8,10 +8,10 @@ import json
 
 import httpx
 import pytest
+from tests.cli.conftest import run
 from tests.cli.test_procedures_cli_server import servostudio
 from tests.support.motion_timing import InProcessServer
 
-from servostudio.cli import main
 from servostudio.sim.plant import Plant
 
 PINNED = {"inertia_kgm2", "viscous_friction_nms_per_rad", "coulomb_friction_nm", "load_torque_nm", "residual",
@@ -21,12 +21,6 @@ PINNED = {"inertia_kgm2", "viscous_friction_nms_per_rad", "coulomb_friction_nm",
 @pytest.fixture(autouse=True)
 def data_dir(tmp_path, monkeypatch):
     monkeypatch.setenv("SERVOSTUDIO_DATA_DIR", str(tmp_path / "data"))
-
-
-def run(capsys, *argv: str) -> tuple[int, str, str]:
-    code = main(list(argv))
-    captured = capsys.readouterr()
-    return code, captured.out, captured.err
 
 
 def test_identify_prints_the_pinned_plant(capsys):

@@ -6,19 +6,12 @@ from __future__ import annotations
 import json
 
 import pytest
-
-from servostudio.cli import main
+from tests.cli.conftest import run
 
 
 @pytest.fixture(autouse=True)
 def data_dir(tmp_path, monkeypatch):
     monkeypatch.setenv("SERVOSTUDIO_DATA_DIR", str(tmp_path / "data"))
-
-
-def run(capsys, *argv: str) -> tuple[int, str, str]:
-    code = main(list(argv))
-    captured = capsys.readouterr()
-    return code, captured.out, captured.err
 
 
 def test_currentloop_prints_the_gains_and_limits_before_and_after(capsys):

@@ -13,8 +13,8 @@ from servostudio.od import builtin_library
 SIMULATOR_ONLY = 0x5F00
 
 
-@pytest.mark.parametrize("device", sorted(PROFILES))
-def test_every_io_object_is_in_the_dictionary(device: str):
+@pytest.mark.parametrize("device", sorted(device for device, profile in PROFILES.items() if profile.canopen))
+def test_every_io_object_is_in_the_dictionary(device: str):  # the TTA-PRO's I/O is a later stage (profibus.md §11)
     profile, od = PROFILES[device], builtin_library().load(device)
     io = profile.io
     assert io is not None

@@ -68,7 +68,7 @@ def test_timeout_names_node_and_object(engine):
 
 def test_link_down_fails_transfers_clearly(engine):
     engine.link.close()
-    with pytest.raises(SdoLinkError, match="not connected"):
+    with pytest.raises(SdoLinkError, match="bus test was closed"):  # not "not connected": nobody will reconnect it
         engine.upload(1, 0x2001, 0).result(2)
 
 
@@ -254,7 +254,7 @@ def test_closing_the_bus_fails_the_work_in_flight_at_once(engine):
     assert isinstance(outcomes[-1], SdoLinkError) and "bus test was closed" in str(outcomes[-1])
     with pytest.raises(SdoLinkError, match="was closed"):
         single.result(1)
-    with pytest.raises(SdoLinkError, match=r"not connected \(closed\)"):
+    with pytest.raises(SdoLinkError, match="bus test was closed"):  # a request after the close too
         engine.upload(1, 0x2001, 0).result(1)
 
 

@@ -216,6 +216,7 @@ ENCOTRIVE_INDICES = {
     *range(0x1A00, 0x1A06),
     0x2DFE,
     0x2E04,
+    0x2F02,  # the current-controller record, its index the project's reading (docs/decisions.md §6)
     0x6007,
     0x603F,
     0x6040,

@@ -94,11 +94,13 @@ def test_project_file_changes_are_logged_object_by_object(tmp_path):
     new = b"0x6060,0=3\n0x60F9,2=100\n0x6081,0=2000\n"
     journal.axis_file("demo", "x", "DRIVEPAR.TXT", old, new)
     journal.axis_file("demo", "x", "SEQUENCE.TXT", b"a", b"b")
+    journal.axis_file("demo", "x", "TTAPAR.TXT", b"700,0=4\n720,0=10\n", b"700,0=4\n720,0=12\n")  # PNU,IND
     entries = log.entries(AuditQuery(project="demo")).entries[::-1]
     assert [(entry["object"], entry.get("old"), entry.get("new")) for entry in entries] == [
         ("0x6060,0", 1, 3),
         ("0x607A,0", 5, None),
         ("0x6081,0", None, 2000),
         ("SEQUENCE.TXT", None, None),
+        ("0x02D0,0", 10, 12),  # PNU 720 at the address the TTA-PRO's parameter list gives it
     ]
     assert {entry["project_axis"] for entry in entries} == {"x"}

@@ -10,6 +10,7 @@ import pytest
 from servostudio.formats.objectfile import read_object_file
 from servostudio.services.backup import (
     BackupError,
+    BackupPlaceRefused,
     RestoreValidationError,
     backup_file,
     restore_file,
@@ -181,3 +182,13 @@ def test_a_drive_that_stops_answering_ends_the_restore_at_its_first_silent_write
     statuses = [outcome.status for outcome in result.outcomes]
     assert statuses.count("not written") > len(statuses) / 2 and "written" in statuses
     assert restore_file(drive, path).ok  # the node answers again: the same file simply goes in
+
+
+def test_a_backup_makes_its_missing_folder_and_refuses_one_that_cannot_be(connection, tmp_path):
+    drive = connection.drive(1)
+    nested = tmp_path / "2026-12-02" / "line 3" / "DRIVEPAR.TXT"
+    assert backup_file(drive, nested).objects > 300 and _values(nested)
+    (tmp_path / "in the way").write_text("a file, not a folder")
+    with pytest.raises(BackupPlaceRefused, match=r"cannot make the folder for DRIVEPAR\.TXT") as refused:
+        backup_file(drive, tmp_path / "in the way" / "DRIVEPAR.TXT")
+    assert str(tmp_path) not in str(refused.value)  # no server path in the message

@@ -77,6 +77,13 @@ def test_walking_down_the_ladder_is_a_stop_anyone_may_make(state, controlword):
     assert verdict.motion is Motion.STOPS and not verdict.stops  # the axis was not running: no "stop" to log
 
 
+@pytest.mark.parametrize("state", [State.SWITCH_ON_DISABLED, State.FAULT, State.QUICK_STOP_ACTIVE])
+@pytest.mark.parametrize("controlword", [0x02, 0x00, 0x0B, 0x0433 & 0x0F])
+def test_a_quick_stop_or_disable_voltage_is_a_stop_in_every_state(state, controlword):
+    """Even where it changes nothing (an axis already disabled): the watchdog of a hold must never be refused."""
+    assert judge(XTRAPULSPAC, state, [write(CONTROLWORD, controlword)]).motion is Motion.STOPS
+
+
 def test_walking_up_the_ladder_prepares_motion():
     assert judge(XTRAPULSPAC, State.SWITCH_ON_DISABLED, [write(CONTROLWORD, 0x06)]).motion is Motion.PREPARES
     assert judge(XTRAPULSPAC, State.FAULT, [write(CONTROLWORD, 0x80)]).motion is Motion.PREPARES  # fault reset

@@ -43,6 +43,7 @@ class LiveServer:
             str(projects_dir),
             "--data-dir",
             str(self.data_dir),
+            *_private_ui(),
             *(extra_args or []),
         ]
         self.log = projects_dir.parent / f"server-{self.port}.log"
@@ -89,3 +90,10 @@ def live_server(tmp_path_factory: pytest.TempPathFactory):
         yield server
     finally:
         server.stop()
+
+
+def _private_ui() -> list[str]:
+    """``SERVOSTUDIO_TEST_UI=DIR``: serve a UI built into DIR instead of the package's (an engineer trying a
+    frontend change while others' browser tests read the shared build)."""
+    built = os.environ.get("SERVOSTUDIO_TEST_UI")
+    return ["--ui", built] if built else []

@@ -6,7 +6,7 @@ Operation enabled must be the axis's armed controller, exactly as a browser page
 
 from __future__ import annotations
 
-from collections.abc import Iterator
+from collections.abc import Iterator, Sequence
 from contextlib import contextmanager
 
 from servostudio.services.audit import Actor, acting_as
@@ -14,12 +14,15 @@ from servostudio.services.bus import ConnectionManager
 
 
 @contextmanager
-def controlling(manager: ConnectionManager, bus: str, node: int, user: str = "tests") -> Iterator[Actor]:
-    """Inside the block the test acts as the armed controller of node ``node`` on ``bus``; afterwards its client
-    is gone without a quick stop (the test leaves the axis as it wants)."""
+def controlling(
+    manager: ConnectionManager, bus: str, node: int | Sequence[int], user: str = "tests"
+) -> Iterator[Actor]:
+    """Inside the block the test acts as the armed controller of node ``node`` (or of each of several) on ``bus``;
+    afterwards its client is gone without a quick stop (the test leaves the axis as it wants)."""
     guard = manager.motion
     actor = Actor(user, "administrator", guard.connect(user))
-    guard.arm(actor, (bus, node))
+    for each in [node] if isinstance(node, int) else node:
+        guard.arm(actor, (bus, each))
     try:
         with acting_as(actor):
             yield actor

@@ -31,7 +31,7 @@ class ServerState:
     def build(cls, settings: Settings) -> ServerState:
         library = EdsLibrary(settings.builtin_eds_dir, settings.user_eds_dir)
         audit, events = AuditLog(settings.audit_path), EventHub()
-        motion = MotionGuard(events.publish, audit)
+        motion = MotionGuard(events.publish, audit, settings.old_values_up_to)
         connections = ConnectionManager(library, events, motion)
         return cls(
             settings=settings,

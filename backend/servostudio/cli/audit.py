@@ -32,8 +32,9 @@ def audit_log(settings: Settings | None = None) -> AuditLog:
 
 
 def guarded_connections(audit: AuditLog, library: EdsLibrary | None = None) -> ConnectionManager:
-    """A command's buses, their drives writing through a motion guard that records into ``audit``."""
-    return ConnectionManager(library, motion=MotionGuard(audit=audit))
+    """A command's buses, their drives writing through a motion guard that records into ``audit`` (old values as
+    ``SERVOSTUDIO_AUDIT_OLD_VALUES`` says, as the server's ``--audit-old-values``)."""
+    return ConnectionManager(library, motion=MotionGuard(audit=audit, old_values_up_to=Settings().old_values_up_to))
 
 
 def register(commands: argparse._SubParsersAction) -> None:

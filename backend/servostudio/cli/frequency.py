@@ -65,7 +65,7 @@ def register(commands: argparse._SubParsersAction) -> None:
         "--amplitude",
         type=float,
         metavar="PCT",
-        help="plant: % of the rated current (50); closed: % of the base speed (40)",
+        help="plant: %% of the rated current (50); closed: %% of the base speed (40)",
     )
     parser.add_argument("--base-speed", type=float, default=10.0, metavar="RAD_S")
     parser.add_argument("--window", type=float, default=10.0, metavar="REV", help="travel allowed, revolutions")
@@ -129,7 +129,7 @@ def _local(args: argparse.Namespace, request: MeasureRequest, interrupted: threa
             with guard.live_client(local_actor()) as actor:
                 guard.arm(actor, axis)
                 try:
-                    service.check(guard, axis, drive, FrequencyRequest(request))
+                    service.check(guard, axis, drive, FrequencyRequest(request), connection.spec.bitrate)
                     confirm(args, _question(args))
                     cancellation = Cancellation()
                     stop_watching = forward_interrupt(interrupted, cancellation)

@@ -57,10 +57,10 @@ def register(commands: argparse._SubParsersAction) -> None:
     parser.add_argument("--acceleration", type=float, metavar="RPM_S", help="ramps, rpm/s (default 5000)")
     parser.add_argument("--hold", type=float, metavar="S", help="cruise at the higher speed, s (default 0.2)")
     parser.add_argument("--window", type=float, metavar="REV", help="position window, revolutions (default 6)")
-    parser.add_argument("--current-limit", type=float, metavar="PCT", help="% of the rated current (default 150)")
+    parser.add_argument("--current-limit", type=float, metavar="PCT", help="%% of the rated current (default 150)")
     parser.add_argument("--cycles", type=int, help="repetitions of the profile (default 2)")
     parser.add_argument(
-        "--bandwidth", type=float, metavar="HZ", help="then tune the speed loop for it (drives with gains)"
+        "--bandwidth", type=float, metavar="HZ", help="then tune the speed loop (gains, or the encoTRive's inertia)"
     )
     parser.add_argument("--yes", action="store_true", help="do not ask before starting")
     remote.add_options(parser, suppress=True)

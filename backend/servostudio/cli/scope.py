@@ -12,7 +12,8 @@ axis of the bus), ``--source auto|recorder|tpdo|poll``, and ``--plan`` (print th
 alignment — and arm nothing).
 
 The files are the capture service's (docs/scope.md): written only once the recording is read completely, each
-atomically, so a failed capture leaves none. Stdout gets a JSON summary; the exit code is the error's kind (3 refused
+atomically, so a failed capture leaves none. Stdout gets a JSON summary (with ``arm`` and ``arm_note``: how a
+recorder capture of several axes was armed, null otherwise); the exit code is the error's kind (3 refused
 before anything was armed, 4 unknown node or object, 5 the bus or the drive failed or no recording in time).
 With ``--server URL`` the server captures on its bus (``--bus`` names it, or its spec; default: its only bus) and
 the files are written here the same way (``cli/scope_remote.py``).
@@ -138,28 +139,40 @@ def _scope(args: argparse.Namespace, parser: argparse.ArgumentParser) -> int:
             return _roll_here(args, connection, drive, definition)
         if args.plan:
             return emit(plan_model(check(drive, definition, connection.drive, bitrate)).model_dump())
+        armed: dict[str, object] = {}  # how a recorder capture of several axes was armed (its "armed" event)
         made = _interruptible(lambda cancellation: capture(drive, identity_of(connection, drive), definition,
-                                                           cancellation=cancellation, axes=connection.drive,
+                                                           _armed_into(armed), cancellation, axes=connection.drive,
                                                            bitrate=bitrate))  # fmt: skip
     except Cancelled as stopped:
         print(f"error: {stopped}; the recorder was stopped", file=sys.stderr)
         return EXIT_INTERRUPTED
     finally:
         manager.close_all()
-    return emit(_write(made, args.out, args.html))
+    return emit({**_write(made, args.out, args.html), "arm": armed.get("arm"), "arm_note": armed.get("note")})
+
+
+def _armed_into(armed: dict[str, object]) -> Callable[[dict[str, object]], None]:
+    """A progress callback keeping the ``armed`` event of a recorder capture of several axes (``arm``, ``note``)."""
+
+    def keep(event: dict[str, object]) -> None:
+        if event.get("stage") == "armed" and "arm" in event:
+            armed.update(event)
+
+    return keep
 
 
 def _through_server(args: argparse.Namespace, bus: ServerBus, definition: CaptureDefinition) -> int:
     if args.plan:
         return emit(bus.call("POST", bus.path(args.node, "/scope/check"), definition.as_dict()))
     try:
-        made = _interruptible(
+        result = _interruptible(
             lambda cancellation: scope_remote.capture_through(bus, args.node, definition, cancellation)
         )
     except Cancelled as stopped:
         print(f"error: {stopped}; the recorder was stopped", file=sys.stderr)
         return EXIT_INTERRUPTED
-    return emit(scope_remote.write_files(bus, args.node, made, args.out, args.html))
+    summary = scope_remote.write_files(bus, args.node, str(result["capture"]), args.out, args.html)
+    return emit({**summary, "arm": result.get("arm"), "arm_note": result.get("arm_note")})
 
 
 def _check_roll(args: argparse.Namespace, parser: argparse.ArgumentParser) -> None:

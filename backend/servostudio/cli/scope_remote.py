@@ -39,8 +39,11 @@ class RemoteCaptureFailed(CommunicationError):
     """The server's capture job failed (the drive, the bus, no recording in time); its reason is the job's."""
 
 
-def capture_through(bus: ServerBus, node: int, definition: CaptureDefinition, cancellation: Cancellation) -> str:
-    """The id of the capture the server made for ``definition``; a cancel stops the server's job and recorder."""
+def capture_through(
+    bus: ServerBus, node: int, definition: CaptureDefinition, cancellation: Cancellation
+) -> dict[str, Any]:
+    """The result of the server's capture job for ``definition`` (``capture``: its id; ``arm``, ``arm_note`` for
+    several axes by their recorders); a cancel stops the server's job and recorder."""
     scope = bus.path(node, "/scope")
     job = bus.call("POST", f"{scope}/captures", definition.as_dict())
     while job["state"] == "running":
@@ -53,7 +56,7 @@ def capture_through(bus: ServerBus, node: int, definition: CaptureDefinition, ca
         raise Cancelled(f"node {node}: the server's capture job {job['id']} was stopped")
     if job["state"] != "done":
         raise RemoteCaptureFailed(f"node {node}: {job['error'] or 'the capture failed'} (server job {job['id']})")
-    return str(job["result"]["capture"])
+    return dict(job["result"])
 
 
 def write_files(bus: ServerBus, node: int, capture_id: str, out: Path, html: Path | None) -> dict[str, Any]:

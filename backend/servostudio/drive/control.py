@@ -43,7 +43,7 @@ def set_state(drive: Drive, target: State, step_timeout: float = STEP_TIMEOUT) -
         if command is None:
             return state
         controlword = int(drive.read("controlword").raw) if drive.variable("controlword").access.readable else 0
-        drive.write("controlword", apply_command(controlword, command))
+        drive.write("controlword", command_word(drive, controlword, command))
         _wait_for_change(drive, state, step_timeout)
     state, statusword = read_state(drive)
     raise StateChangeError(
@@ -71,12 +71,27 @@ def _fault_names(drive: Drive) -> str:
     return f" ({', '.join(fault.name for fault in faults)})" if faults else ""
 
 
+def command_word(drive: Drive, controlword: int, command: Command) -> int:
+    """The control word that gives ``command``: its bits as the device needs them (``controlword_commands``), the
+    device's fixed bits (``controlword_fixed``: the TTA-PRO's control by PROFIBUS, no stop, no intermediate stop),
+    the other bits kept."""
+    profile = drive.profile
+    bits = profile.controlword_commands.get(int(command), int(command))
+    others = apply_command(controlword, Command.DISABLE_VOLTAGE)  # the command bits cleared, the others kept
+    return others | bits | profile.controlword_fixed
+
+
+def quick_stop_word(drive: Drive) -> int:
+    """The quick stop as one control word, written without reading the control word first (lost controller)."""
+    return command_word(drive, 0, Command.QUICK_STOP)
+
+
 def reset_faults(drive: Drive) -> None:
     """Rising edge of control word bit 7, then bit 7 cleared again (the manual: the host must clear it)."""
     controlword = int(drive.read("controlword").raw) & ~0x80
     drive.write("controlword", controlword)
-    drive.write("controlword", apply_command(controlword, Command.FAULT_RESET))
-    drive.write("controlword", controlword & ~0x8F)
+    drive.write("controlword", command_word(drive, controlword, Command.FAULT_RESET))
+    drive.write("controlword", (controlword & ~0x8F) | drive.profile.controlword_fixed)
 
 
 @dataclass
@@ -112,6 +127,7 @@ def fault_report(drive: Drive) -> FaultReport:
     state, statusword = read_state(drive)
     error_code = int(drive.read("error_code").raw) if profile.has("error_code") else 0
     known = profile.emcy_codes.get(error_code)
+    text = (known.name if known else cia402_error_text(error_code)) if profile.has("error_code") else ""
     faults = _word_faults(drive) or [fault for fault in [profile.code_fault(error_code)] if fault]
     failed = profile.procedure_fault is not None and any(fault.code == profile.procedure_fault for fault in faults)
     return FaultReport(
@@ -119,7 +135,7 @@ def fault_report(drive: Drive) -> FaultReport:
         state.value if state else None,
         statusword,
         error_code,
-        known.name if known else cia402_error_text(error_code),
+        text,  # "" for a drive without an error-code object (the TTA-PRO: its faults are its error words)
         faults,
         _warnings(drive),
         procedure_causes(drive) if failed else [],

@@ -101,6 +101,9 @@ class CodedBits:
     first: int
     last: int
     faults: Mapping[int, FaultInfo]
+    #: the first code of the error word the field is in (``DeviceProfile.error_words``); None: in every word (the
+    #: CD1-k has one); the TTA-PRO's code in bits 0-2 of PNU 778 is not in its PNU 773
+    word: int | None = None
 
     @property
     def mask(self) -> int:
@@ -110,7 +113,8 @@ class CodedBits:
         value = (word & self.mask) >> self.first
         if not value:
             return []
-        unknown = FaultInfo(self.first + 1, 0, f"coded fault {value:#b} in bits {self.first}-{self.last}", "")
+        code = (self.word if self.word is not None else 1) + self.first  # the code of the field's first bit
+        unknown = FaultInfo(code, 0, f"coded fault {value:#b} in bits {self.first}-{self.last}", "")
         return [self.faults.get(value, unknown)]
 
 
@@ -119,14 +123,15 @@ def faults_from_words(
 ) -> list[FaultInfo]:
     """Active faults of error words given as ``(value, first_code)``: bit b of a word is code first_code + b, except
     the ``coded`` bit fields, which hold one code each."""
-    coded_mask = sum(field.mask for field in coded)
     active = []
     for value, first_code in words:
+        fields = [field for field in coded if field.word in (None, first_code)]
+        coded_mask = sum(field.mask for field in fields)
         for bit in range(32):
             if value >> bit & 1 and not coded_mask >> bit & 1:
                 code = first_code + bit
                 active.append(table.get(code, FaultInfo(code, 0, f"error code {code} (not in the manual)", "")))
-        active.extend(fault for field in coded for fault in field.decode(value))
+        active.extend(fault for field in fields for fault in field.decode(value))
     return active
 
 

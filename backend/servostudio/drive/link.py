@@ -95,7 +95,9 @@ class BusLink:
         bus = self._bus
         if bus is None or not self.connected:
             detail = f" ({self.last_error})" if self.last_error else ""
-            raise LinkDownError(f"bus {self.name} is not connected{detail}")
+            raise LinkDownError(
+                f"bus {self.name} was closed" if self.closed else f"bus {self.name} is not connected{detail}"
+            )
         if self._held is not None and threading.current_thread() is self._thread:
             self._held.append((cob_id, data))  # leaves with the rest of the batch's answers
             return

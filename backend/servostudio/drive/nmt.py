@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import enum
+import weakref
+from collections.abc import Callable
 
 from servostudio.drive.link import BusLink
 from servostudio.errors import InvalidInput
@@ -37,10 +39,35 @@ class NmtCommand(enum.IntEnum):
 NMT_STATES = {0x00: "INITIALISING", 0x04: "STOPPED", 0x05: "OPERATIONAL", 0x7F: "PRE-OPERATIONAL"}
 
 
+#: hears an NMT command's outcome: None once the frame is on the bus, else the error that kept it off
+NmtHeard = Callable[[BaseException | None], None]
+#: judges an NMT command before it is sent (raising refuses it) and returns what hears its outcome
+NmtGate = Callable[[NmtCommand, int], NmtHeard]
+_gates: weakref.WeakKeyDictionary[BusLink, NmtGate] = weakref.WeakKeyDictionary()
+
+
+def guard_nmt(link: BusLink, gate: NmtGate) -> None:
+    """Have ``gate`` (the bus connection's motion guard) judge every NMT command sent on ``link`` from now on,
+    whoever sends it — the NMT route, a capture starting its silent nodes, a measurement — so none goes around it."""
+    _gates[link] = gate
+
+
 def send_nmt(link: BusLink, command: NmtCommand, node: int = 0) -> None:
+    """Send one NMT command (node 0: all nodes), judged first by the link's gate if it has one."""
     if not 0 <= node <= 127:
         raise InvalidInput(f"node ID {node} outside 0..127 (0 = all nodes)")
-    link.send(0x000, bytes([int(command), node]))
+    gate = _gates.get(link)
+    heard = gate(command, node) if gate is not None else _unheard
+    try:
+        link.send(0x000, bytes([int(command), node]))
+    except BaseException as error:
+        heard(error)
+        raise
+    heard(None)
+
+
+def _unheard(error: BaseException | None) -> None:
+    """A link without a gate (a bare link of a test or tool) logs nothing."""
 
 
 #: what an SDO answer proves: a STOPPED or initialising node answers no SDO (CiA 301 §7.3.2.2)

@@ -43,13 +43,17 @@ class RpdoConfig:
 
 
 def last_rpdo(drive: Drive) -> int:
-    """The highest-numbered RPDO whose communication and mapping objects the dictionary has."""
+    """The highest-numbered RPDO whose communication and mapping objects the dictionary has, with a COB-ID of its
+    own: one whose default COB-ID has no identifier (CiA 301 predefines them for RPDO 1–4 only; the encoTRive's
+    RPDO 5 and 6 default to 0x80000000) would be sent on 0x000 — as NMT commands every node obeys."""
     dictionary = drive.dictionary
     for number in reversed(range(RPDO_LIMIT)):
+        cob_id = dictionary.get(RPDO_COMMUNICATION + number, 1) if dictionary is not None else None
         if (
             dictionary is not None
             and dictionary.get(RPDO_MAPPING + number, 1) is not None
-            and dictionary.get(RPDO_COMMUNICATION + number, 1) is not None
+            and cob_id is not None
+            and not (isinstance(cob_id.default, int) and not cob_id.default & COB_ID_MASK)
         ):
             return number
     raise NoRpdo(f"node {drive.node}: the {drive.profile.device} has no receive PDO")

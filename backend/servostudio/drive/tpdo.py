@@ -53,12 +53,16 @@ class TpdoConfig:
 
 
 def tpdo_slots(dictionary: ObjectDictionary) -> list[TpdoSlot]:
-    """The TPDOs whose communication and mapping objects the dictionary has, and writable mappings."""
+    """The TPDOs whose communication and mapping objects the dictionary has, with writable mappings and a COB-ID of
+    their own: a TPDO whose default COB-ID has no identifier (CiA 301 predefines them for TPDO 1–4 only; the
+    encoTRive's TPDO 5 and 6 default to 0x80000000) would transmit on 0x000 — the NMT identifier every node obeys."""
     slots = []
     for number in range(TPDO_LIMIT):
         count = dictionary.get(TPDO_MAPPING + number, 0)
         cob_id = dictionary.get(TPDO_COMMUNICATION + number, 1)
         if count is None or cob_id is None or not count.access.writable or not cob_id.access.writable:
+            continue
+        if isinstance(cob_id.default, int) and not cob_id.default & COB_ID_MASK:
             continue
         entries = sum(1 for sub in range(1, 65) if dictionary.get(TPDO_MAPPING + number, sub) is not None)
         if entries:

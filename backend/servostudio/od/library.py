@@ -1,7 +1,9 @@
 """The EDS library: built-in dictionaries (`<repo>/eds`) plus dictionaries the user imported (a user directory).
 
 Devices are keyed by the EDS file name without suffix, lower-case (`xtrapulspac`). A user dictionary with the same
-key as a built-in one is refused at import, so a key always means one file.
+key as a built-in one is refused at import, so a key always means one file. A PROFIBUS parameter list
+(`<device>.pnu`, docs/profibus.md §2) is a device of the library too (`ttapro`): it loads as a `ParameterDictionary`,
+an `ObjectDictionary` with index = PNU, subindex = IND, and matches by its DP ident number (vendor ID 0).
 """
 
 from __future__ import annotations
@@ -64,7 +66,7 @@ class EdsLibrary:
         """The dictionary of `device`, loaded once and cached."""
         with self._lock:
             if device not in self._cache:
-                self._cache[device] = load_dictionary(self.path_of(device))
+                self._cache[device] = _load_file(self.path_of(device))
             return self._cache[device]
 
     def import_eds(self, eds_path: Path, props_path: Path | None = None) -> str:
@@ -125,7 +127,21 @@ class EdsLibrary:
     def _files(directory: Path | None) -> dict[str, Path]:
         if directory is None or not directory.is_dir():
             return {}
-        return {path.stem.lower(): path for path in sorted(directory.glob("*.eds")) if path.is_file()}
+        files = [path for suffix in DICTIONARY_SUFFIXES for path in sorted(directory.glob(f"*{suffix}"))]
+        return {key: path for path in reversed(files) if path.is_file() for key in [path.stem.lower()]}
+
+
+DICTIONARY_SUFFIXES = (".eds", ".pnu")
+"""What the library lists, in this order of precedence for one key: CiA 306 EDS, PROFIBUS parameter lists."""
+
+
+def _load_file(path: Path) -> ObjectDictionary:
+    """An EDS (with its .props), or a PROFIBUS parameter list (``od/pnu.py`` builds on this module: imported here)."""
+    if path.suffix.lower() == ".pnu":
+        from servostudio.od.pnu import load_parameter_list
+
+        return load_parameter_list(path)
+    return load_dictionary(path)
 
 
 _builtin: EdsLibrary | None = None

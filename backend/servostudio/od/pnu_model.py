@@ -96,14 +96,30 @@ class PnuVariable(Variable):
         return f"{address} {self.parent_name}"
 
 
+CONTROL_WORD = 0x800
+STATUS_WORD = 0x801
+"""The PZD1 words as dictionary entries, at addresses no PNU can have (the PKW PNU field has 11 bits: 0..2047), so
+a `Drive` reads the status word and writes the control word like any object and the motion guard judges the control
+word where it judges every write (docs/profibus.md §12); the PKW engine carries them through PZD, not PKW."""
+
+
+class PzdVariable(Variable):
+    """A process-data word of the PPO (PZD1 control or status word), not a parameter."""
+
+    @property
+    def label(self) -> str:
+        return self.name
+
+
 class ParameterDictionary(ObjectDictionary):
-    """An `ObjectDictionary` of PNUs that also keeps the `Parameter` records and the DP ident number."""
+    """An `ObjectDictionary` of PNUs that also keeps the `Parameter` records and the DP ident number, and the PZD1
+    control and status words (`CONTROL_WORD`, `STATUS_WORD`)."""
 
     def __init__(self, device: str, product_name: str, ident_number: int, source: Path, parameters: list[Parameter]):
         self.ident_number = ident_number
         self.parameters = {parameter.pnu: parameter for parameter in sorted(parameters, key=lambda p: p.pnu)}
         objects = [_dictionary_object(parameter) for parameter in self.parameters.values()]
-        super().__init__(device, product_name, 0, ident_number, 0, source, objects)
+        super().__init__(device, product_name, 0, ident_number, 0, source, [*objects, *_process_data()])
 
     def find(self, name: str) -> Variable:
         """Look an entry up by PNU ("PNU700", "700", "PNU795[5]", "795,5") or by name (see ObjectDictionary)."""
@@ -115,6 +131,27 @@ class ParameterDictionary(ObjectDictionary):
         if variable is None:
             raise KeyError(f"{self.device}: no parameter {name!r}")
         return variable
+
+
+def _process_data() -> list[DictObject]:
+    """PZD1 of the PPO write (STW) and of the PPO read (ZSW): words, not saved, outside every backup."""
+    words = (
+        (CONTROL_WORD, "PZD1 control word STW", Access.RW, "the enabling commands and the positioner's (L427-478)"),
+        (STATUS_WORD, "PZD1 status word ZSW", Access.RO, "the enabling stage and the positioner's state (L494-535)"),
+    )
+    return [
+        DictObject(index, name, ObjectKind.VAR, PROCESS_DATA, {0: _pzd_variable(index, name, access, text)})
+        for index, name, access, text in words
+    ]
+
+
+PROCESS_DATA = "Process data (PZD)"
+
+
+def _pzd_variable(index: int, name: str, access: Access, description: str) -> PzdVariable:
+    return PzdVariable(
+        index, 0, name, DataType.UNSIGNED16, access, group=PROCESS_DATA, description=description, parent_name=name
+    )
 
 
 def _dictionary_object(parameter: Parameter) -> DictObject:

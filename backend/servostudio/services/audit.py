@@ -29,7 +29,7 @@ from datetime import UTC, datetime, timedelta
 from pathlib import Path
 
 from servostudio.errors import InvalidInput
-from servostudio.formats.objectfile import parse_object_file
+from servostudio.formats.parameterfile import parse_drive_file
 from servostudio.formats.textfile import FILE_ENCODING
 
 #: the columns of an entry, in the order CSV exports them
@@ -50,7 +50,7 @@ FIELDS = (
     "detail",
 )
 #: the project files whose changes are logged object by object (``formats.objectfile``)
-OBJECT_FILES = frozenset({"DRIVEPAR.TXT", "USER_PAR.TXT"})
+OBJECT_FILES = frozenset({"DRIVEPAR.TXT", "USER_PAR.TXT", "TTAPAR.TXT"})
 #: what a log without a file keeps in memory (a tool or test that gave no data directory)
 MEMORY_ENTRIES = 10_000
 MAX_PAGE = 1000
@@ -280,7 +280,7 @@ class ProjectAudit:
 def _file_changes(file_name: str, old: bytes, new: bytes) -> list[dict[str, object]]:
     """Object by object for a parameter file; one entry for any other file (SEQUENCE.TXT, a capture)."""
     object_file = file_name.upper() in OBJECT_FILES
-    before, after = (_object_values(old), _object_values(new)) if object_file else (None, None)
+    before, after = (_object_values(file_name, old), _object_values(file_name, new)) if object_file else (None, None)
     if before is None or after is None:
         return [] if old == new else [{"object": file_name, "detail": f"{file_name} replaced"}]
     keys = sorted(set(before) | set(after))
@@ -291,10 +291,11 @@ def _file_changes(file_name: str, old: bytes, new: bytes) -> list[dict[str, obje
     ]
 
 
-def _object_values(data: bytes) -> dict[tuple[int, int], int | str] | None:
-    """The assignments of an object file, or None when the text is not one."""
+def _object_values(file_name: str, data: bytes) -> dict[tuple[int, int], int | str] | None:
+    """The assignments of a parameter file in its syntax (TTAPAR.TXT's PNU,IND too), or None when the text is not
+    one."""
     try:
-        entries = parse_object_file(data.decode(FILE_ENCODING))
+        entries = parse_drive_file(file_name, data.decode(FILE_ENCODING))
     except (InvalidInput, UnicodeDecodeError):
         return None
     return {(entry.index, entry.sub): entry.value for entry in entries}

@@ -12,6 +12,8 @@ profile's signature, and reports per object.  A restore that fails part-way list
 again is safe (it writes the same values).
 
 SEQUENCE.TXT goes through 0x3610 (select) / 0x3611 (26 parameters) with ``servostudio.formats.sequence``.
+TTAPAR.TXT, a PROFIBUS drive's (TTA-PRO) E parameters, is the object file with ``PNU,IND`` addresses
+(``servostudio.formats.parameterfile``, docs/profibus.md §10); it is backed up and restored the same way.
 """
 
 from __future__ import annotations
@@ -34,9 +36,10 @@ from servostudio.drive.object_values import ObjectValue
 from servostudio.drive.profiles import DeviceProfile
 from servostudio.drive.sdo import SAFETY_WAIT, SdoAbortError, SdoError, TransferBatch, settle
 from servostudio.errors import CommunicationError, InvalidInput, RefusedForSafety, ServoStudioError
-from servostudio.formats.objectfile import ObjectEntry, ObjectFileError, parse_object_file, write_object_file
+from servostudio.formats.objectfile import ObjectEntry, ObjectFileError
+from servostudio.formats.parameterfile import format_drive_file, parse_drive_file
 from servostudio.formats.sequence import SequenceFileError, SequenceTable, parse_sequence_text, write_sequence_file
-from servostudio.formats.textfile import FILE_ENCODING
+from servostudio.formats.textfile import FILE_ENCODING, write_text_atomic
 from servostudio.od.datatypes import DataType
 from servostudio.od.model import SaveType, Variable
 from servostudio.services.cancel import Cancellation, Cancelled
@@ -52,6 +55,7 @@ class FileKind(enum.StrEnum):
     DRIVEPAR = "DRIVEPAR.TXT"
     USER_PAR = "USER_PAR.TXT"
     SEQUENCE = "SEQUENCE.TXT"
+    TTAPAR = "TTAPAR.TXT"
 
     @classmethod
     def from_path(cls, path: Path) -> FileKind:
@@ -64,11 +68,19 @@ class FileKind(enum.StrEnum):
 
     @property
     def save_type(self) -> SaveType | None:
-        return {FileKind.DRIVEPAR: SaveType.DRIVEPAR, FileKind.USER_PAR: SaveType.USER_PAR}.get(self)
+        return {
+            FileKind.DRIVEPAR: SaveType.DRIVEPAR,
+            FileKind.USER_PAR: SaveType.USER_PAR,
+            FileKind.TTAPAR: SaveType.DRIVEPAR,
+        }.get(self)
 
 
 class BackupError(CommunicationError, RuntimeError):
     """A backup or restore that could not complete; nothing half-written is left behind."""
+
+
+class BackupPlaceRefused(InvalidInput):
+    """The folder a backup file goes to cannot be made (a file in the way, no permission)."""
 
 
 class RestoreValidationError(InvalidInput, BackupError):
@@ -155,6 +167,15 @@ def backup_objects(drive: Drive, save_type: SaveType) -> list[Variable]:
     ]
 
 
+def _make_folder(folder: Path, what: str) -> None:
+    """The folder a backup is written to, made before anything is read (a missing one is made, as ``DIR/node<N>/``
+    is); refused with the reason — without the server's path — when it cannot be."""
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+    except OSError as error:
+        raise BackupPlaceRefused(f"cannot make the folder for {what}: {error.strerror or error}") from None
+
+
 def backup_file(
     drive: Drive,
     path: Path,
@@ -166,6 +187,7 @@ def backup_file(
     raises Cancelled)."""
     kind = kind or FileKind.from_path(path)
     started = time.monotonic()
+    _make_folder(path.parent, path.name)
     if cancel is not None:
         cancel.check(f"{kind.value} of node {drive.node} was read")
     if kind is FileKind.SEQUENCE:
@@ -188,7 +210,7 @@ def backup_file(
             )
             continue
         entries.append(ObjectEntry(value.variable.index, value.variable.subindex, file_value))
-    write_object_file(path, entries, header=_header(drive, kind))
+    write_text_atomic(path, format_drive_file(kind.value, entries, header=_header(drive, kind)))
     return BackupResult(drive.node, str(path), kind.value, len(entries), skipped, time.monotonic() - started)
 
 
@@ -265,7 +287,7 @@ def backup_drive(
     """All backup files of a drive into ``directory`` (the profile's parameter files, plus SEQUENCE.TXT).
 
     When cancelled, the files completed so far are returned (``cancel.requested`` tells the caller)."""
-    directory.mkdir(parents=True, exist_ok=True)
+    _make_folder(directory, "the backup")
     results = []
     for kind in kinds or drive_file_kinds(drive):
         try:
@@ -328,9 +350,11 @@ def run_per_drive(drives: list[Drive], work: Callable[[Drive], T]) -> dict[int, 
 
 
 # --------------------------------------------------------------------------------------------------- restore --
-def validate_object_text(drive: Drive, text: str, name: str) -> list[tuple[ObjectEntry, Variable, bytes]]:
-    """Parse and check a whole object file (``name`` as messages call it); raise RestoreValidationError
-    (``NAME:LINE: reason``) on the first problem."""
+def validate_object_text(
+    drive: Drive, text: str, name: str, kind: FileKind = FileKind.DRIVEPAR
+) -> list[tuple[ObjectEntry, Variable, bytes]]:
+    """Parse and check a whole object file (``name`` as messages call it; TTAPAR.TXT in its own syntax); raise
+    RestoreValidationError (``NAME:LINE: reason``) on the first problem."""
     checked: list[tuple[ObjectEntry, Variable, bytes]] = []
 
     def validate(entry: ObjectEntry) -> str | None:
@@ -344,7 +368,7 @@ def validate_object_text(drive: Drive, text: str, name: str) -> list[tuple[Objec
         return None
 
     try:
-        parse_object_file(text, name, validate)
+        parse_drive_file(kind.value, text, name, validate)
     except ObjectFileError as error:
         raise RestoreValidationError(f"{error} — nothing was written to node {drive.node}") from None
     return checked
@@ -401,7 +425,7 @@ def restore_text(
     if kind is FileKind.SEQUENCE:
         table, writes = _validated_sequence_writes(drive, text)
     else:
-        checked = validate_object_text(drive, text, Path(file).name if file else kind.value)
+        checked = validate_object_text(drive, text, Path(file).name if file else kind.value, kind)
         writes = [(var, _entry_value(var, entry.value)) for entry, var, _ in checked]
     _check_can_store(drive, store)
     if cancel is not None and cancel.requested:

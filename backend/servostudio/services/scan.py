@@ -6,6 +6,11 @@ responders are then identified in parallel (0x1018 identity, 0x1008/0x1009/0x100
 to a device dictionary of the EDS library.  A serial link only reaches nodes 1–63 (the redirection range).
 XtrapulsPac drives also answer on 0x600+(n+64), their redirected channel; such an echo of node n is not
 reported as node n+64.
+
+A PROFIBUS-DP line (a TTA-PRO) has no SDO: its stations are found by Slave_Diag on 3..125 (0..2 are the masters'
+addresses by convention; the master's own is skipped), and each ident number is matched to a parameter list of
+the library (vendor ID 0, product code = ident number). The nodes are the station addresses, and the result has
+the same shape as on a CANopen bus (docs/profibus.md §9).
 """
 
 from __future__ import annotations
@@ -13,15 +18,18 @@ from __future__ import annotations
 from concurrent.futures import Future
 from typing import Any
 
+from servostudio.drive.profibus.link import ProfibusLink
 from servostudio.drive.sdo import SdoAbortError, SdoError, SdoLinkError, settle
-from servostudio.errors import NotFound, Timeout, Unavailable
+from servostudio.errors import CommunicationError, NotFound, Timeout, Unavailable
 from servostudio.od.datatypes import DataType, decode
 from servostudio.services.bus.connections import BusConnection, NodeInfo
+from servostudio.transport.profibus.dp_services import SlaveDiag
 
 PROBE_TIMEOUT = 0.15
 PROBE_ROUNDS = 2
 REDIRECT_OFFSET = 64
 SERIAL_PROBE_TIMEOUT = 0.4
+DP_STATIONS = range(3, 126)
 _IDENTITY = {
     "vendor_id": (0x1018, 1, DataType.UNSIGNED32),
     "product_code": (0x1018, 2, DataType.UNSIGNED32),
@@ -59,6 +67,9 @@ _EMPTY_REASONS = {
     "on the link is powered; the link reaches nodes 1-63 through it",
     "socketcand": "the socketcand server's channel (socketcand:HOST:PORT/CHANNEL, can0 by default) may be another "
     "one than the drives'",
+    "profibus": "no DP station answered Slave_Diag on 3-125: check the RS-485 line (termination at both ends, "
+    "A/B not swapped), that its baud rate is the line's, that the drives are powered and their station addresses "
+    "set, and that no other master holds them",
 }
 _CAN_REASONS = (
     "the drives are not powered (logic supply), the bit rate differs from the drives' (every node and the "
@@ -70,7 +81,7 @@ def empty_scan_hint(connection: BusConnection) -> str:
     """Why a scan of this bus found no node: the likely reasons for its kind of bus."""
     kind = connection.spec.kind
     reasons = [_EMPTY_REASONS[kind]] if kind in _EMPTY_REASONS else []
-    if kind not in ("sim", "serial", "virtual"):
+    if kind not in ("sim", "serial", "virtual", "profibus"):
         reasons.append(_CAN_REASONS)
     return f"no node answered on {connection.spec}: " + "; or ".join(reasons)
 
@@ -81,9 +92,13 @@ def scan(connection: BusConnection, nodes: range | list[int] | None = None) -> l
     A bus lost or closed meanwhile ends the scan with `ScanInterrupted` at once: silence on a dead link says
     nothing about the nodes, so the nodes known before are kept."""
     try:
+        if isinstance(connection.link, ProfibusLink):
+            return _scan_profibus(connection, connection.link, nodes)
         return _scan(connection, nodes)
     except SdoLinkError as error:
         raise ScanInterrupted(f"scan of bus {connection.id} stopped: {error.reason}") from None
+    except Unavailable as error:  # the DP line failed
+        raise ScanInterrupted(f"scan of bus {connection.id} stopped: {error}") from None
 
 
 def _scan(connection: BusConnection, nodes: range | list[int] | None) -> list[NodeInfo]:
@@ -104,7 +119,14 @@ def _scan(connection: BusConnection, nodes: range | list[int] | None) -> list[No
     for node in [node for node in present if node > REDIRECT_OFFSET and node - REDIRECT_OFFSET in present]:
         del present[node]  # 0x600+(n+64) is node n's redirected SDO channel, not another node
     found = [_identify(connection, node, device_type) for node, device_type in sorted(present.items())]
-    if nodes is None:
+    return _remember(connection, candidates, found, everything=nodes is None)
+
+
+def _remember(
+    connection: BusConnection, candidates: list[int], found: list[NodeInfo], everything: bool
+) -> list[NodeInfo]:
+    """Keep what the scan found (of every node, or of the candidates only) and tell the subscribers."""
+    if everything:
         connection.nodes = {}
     for node in candidates:
         connection.nodes.pop(node, None)
@@ -115,8 +137,37 @@ def _scan(connection: BusConnection, nodes: range | list[int] | None) -> list[No
     return found
 
 
+def _scan_profibus(connection: BusConnection, link: ProfibusLink, nodes: range | list[int] | None) -> list[NodeInfo]:
+    """Slave_Diag on every candidate station; each answer's ident number names its device."""
+    own = connection.spec.profibus_master
+    candidates = [node for node in (nodes if nodes is not None else DP_STATIONS) if node != own]
+    stations: dict[int, SlaveDiag] = {}
+    for _ in range(PROBE_ROUNDS):  # as on CAN: a second round catches a station whose first answer was late
+        stations.update(link.master.scan([node for node in candidates if node not in stations]))
+    found = [_dp_node(connection, address, diag.ident_number) for address, diag in sorted(stations.items())]
+    return _remember(connection, candidates, found, everything=nodes is None)
+
+
+def _dp_node(connection: BusConnection, address: int, ident_number: int) -> NodeInfo:
+    device = connection.library.match(0, ident_number)
+    name = connection.library.load(device).product_name if device else None
+    return NodeInfo(node=address, device=device, vendor_id=0, product_code=ident_number, device_name=name)
+
+
+def _identify_station(connection: BusConnection, link: ProfibusLink, node: int) -> NodeInfo | None:
+    try:
+        diag = link.master.slave_diag(node)
+    except (Timeout, CommunicationError):  # no answer, or not a DP slave's answer
+        return None
+    info = _dp_node(connection, node, diag.ident_number)
+    connection.nodes[node] = info
+    return info
+
+
 def identify(connection: BusConnection, node: int) -> NodeInfo | None:
     """Identify one node (or None if it does not answer) and remember it."""
+    if isinstance(connection.link, ProfibusLink):
+        return _identify_station(connection, connection.link, node)
     for _ in range(PROBE_ROUNDS):
         probe = connection.engine.upload(node, 0x1000, 0, probe=True)
         if _answered(probe):

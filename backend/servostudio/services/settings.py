@@ -15,7 +15,9 @@ from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
+from servostudio.errors import InvalidInput
 from servostudio.od.library import builtin_eds_dir, default_user_eds_dir
+from servostudio.services.motion.guard import OLD_VALUES_UP_TO
 from servostudio.services.projects.motors import builtin_motors_dir
 
 #: the built browser UI (``npm run build`` writes it)
@@ -38,6 +40,19 @@ def default_export_dir() -> Path | None:
     return Path(configured) if configured else None
 
 
+#: which drive writes the audit log reads the old value of first (``--audit-old-values``): up to 16 objects at
+#: once (a single edit, a small batch; a restore then logs ``old: null``), or every write (a restore takes ~1.4×)
+AUDIT_OLD_VALUES = {"small-writes": OLD_VALUES_UP_TO, "every-write": None}
+
+
+def default_audit_old_values() -> str:
+    return os.environ.get("SERVOSTUDIO_AUDIT_OLD_VALUES", "small-writes")
+
+
+class UnknownAuditChoice(InvalidInput):
+    """An ``--audit-old-values`` / ``SERVOSTUDIO_AUDIT_OLD_VALUES`` that is not one of the choices."""
+
+
 @dataclass(frozen=True)
 class Settings:
     projects_dir: Path = Path("projects")
@@ -54,6 +69,17 @@ class Settings:
     allowed_hosts: tuple[str, ...] = ()  # Host values accepted besides the loopback names and `host`
     allowed_origins: tuple[str, ...] = ()  # browser origins accepted besides the server's own
     audit_file: Path | None = None  # the audit log (JSON lines); None: ``audit.jsonl`` in ``data_dir``
+    audit_old_values: str = field(default_factory=default_audit_old_values)  # a key of ``AUDIT_OLD_VALUES``
+
+    def __post_init__(self) -> None:
+        if self.audit_old_values not in AUDIT_OLD_VALUES:
+            choices = ", ".join(AUDIT_OLD_VALUES)
+            raise UnknownAuditChoice(f"audit old values {self.audit_old_values!r}: use one of {choices}")
+
+    @property
+    def old_values_up_to(self) -> int | None:
+        """The largest write batch whose old values the audit log reads first (None: every batch)."""
+        return AUDIT_OLD_VALUES[self.audit_old_values]
 
     @classmethod
     def given(cls, **flags: Any) -> Settings:

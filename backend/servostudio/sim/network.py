@@ -152,6 +152,7 @@ class SimulatedNetwork:
         #: while running, SYNCs from outside lock the drives' cycle (servostudio.sim.sync_lock)
         self.sync_lock = SyncLock(self._cycle_periods)
         self._speed = 1.0
+        self._origin = (0.0, 0.0)  # while running free: the (wall, virtual) instants its time counts from
         self._thread: threading.Thread | None = None
         self._stop = threading.Event()
         self._posted: deque[Callable[[], None]] = deque()
@@ -220,22 +221,22 @@ class SimulatedNetwork:
 
     def _run(self, wake: socket.socket) -> None:
         """The clock thread; `wake` is the read end of the wake-up pair, open until the thread has ended."""
-        origin = (time.monotonic(), self.clock.now)  # (wall, virtual) instants free-running time counts from
+        self._origin = (time.monotonic(), self.clock.now)  # (wall, virtual) instants free-running time counts from
         locked: Window | None = None
         while not self._stop.is_set():
             with self.lock:
                 was_locked, locked = locked, self.sync_lock.window(time.monotonic())
                 if was_locked is not None and locked is None:  # the SYNCs ended: free-running from here
-                    origin = (time.monotonic(), self.clock.now)
-                target = self._target(origin, locked)
+                    self._origin = (time.monotonic(), self.clock.now)
+                target = self._target(self._origin, locked)
                 self._run_chunk(min(target, self.clock.now + CHUNK))
                 behind = target - self.clock.now
                 due = self.clock.next_event_time()
-            if behind > MAX_LAG and locked is None:
-                origin = (origin[0] + (behind - MAX_LAG) / self._speed, origin[1])  # slip: the host is too slow
+            if behind > MAX_LAG and locked is None:  # slip: the host is too slow
+                self._origin = (self._origin[0] + (behind - MAX_LAG) / self._speed, self._origin[1])
             wait = 0.0
             if behind <= 0:  # until the next event, counted from now: running the chunk took time too
-                present = self._target(origin, locked)
+                present = self._target(self._origin, locked)
                 wait = IDLE_WAIT if due is None else min(IDLE_WAIT, due - present)
             self._wait_for_readers(wake, max(wait, 0.0))
 
@@ -248,10 +249,14 @@ class SimulatedNetwork:
     def _cycle_periods(self) -> set[float]:
         return {period for node in self._node_list if (period := node.cycle_period()) > 0}
 
-    def _transmit_from_outside(self, frame: Frame, sender: Station | None) -> None:
-        """A client's frame onto the bus; while running, a SYNC first runs the drives to its slot (sync_lock)."""
+    def _transmit_from_outside(self, frame: Frame, sender: Station | None, sent: float) -> None:
+        """A client's frame onto the bus; while running, a SYNC first runs the drives to its slot (sync_lock), or —
+        free-running — to the instant it was sent (``sent``, monotonic): a real drive answers a SYNC when it comes,
+        and the SYNCs a starved clock thread finds queued must not all be answered at one virtual instant."""
         if self.running and any(node.consumes_sync(frame) for node in self._node_list):
-            slot = self.sync_lock.slot(self.clock.now, time.monotonic())
+            slot = self.sync_lock.slot(self.clock.now, sent)
+            if not self.sync_lock.locked:
+                slot = max(slot, self._origin[1] + (sent - self._origin[0]) * self._speed)
             if slot > self.clock.now:
                 self.clock.run_until(slot)
         self.bus.transmit(frame, sender)
@@ -302,7 +307,8 @@ class SimulatedNetwork:
 
     def inject(self, frame: Frame, sender: Station | None = None) -> None:
         """Put a frame from outside (client, socketcand, serial) on the bus at the current virtual time."""
-        self.post(lambda: self._transmit_from_outside(frame, sender))
+        sent = time.monotonic()
+        self.post(lambda: self._transmit_from_outside(frame, sender, sent))
 
     def post(self, action: Callable[[], None]) -> None:
         """Run `action` inside the simulation: while running, on its thread after the current chunk (the caller does

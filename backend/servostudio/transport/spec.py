@@ -2,12 +2,14 @@
 
 ``socketcan:can0``, ``pcan:PCAN_USBBUS1@1000000``, ``ixxat:0@500000``, ``kvaser:0``,
 ``slcan:/dev/ttyACM0@1000000``, ``socketcand:HOST:PORT[/CHANNEL]``, ``virtual:NAME``,
-``serial:PORT_OR_URL[@BAUD]`` (the XtrapulsPac RS-232 link) and ``sim[:NODES]`` (simulated drives in
-this process, NODES as for ``servostudio sim``, e.g. ``1:xtrapulspac,2:cd1k``).  Any other interface python-can
-knows — its built-in backends and the plugins installed beside it (``gs_usb:``, ``udp_multicast:``, ``vector:``,
-…) — is spelled the same way, ``INTERFACE:CHANNEL[@BITRATE]``, and every kind takes the interface's own options
-as a query, ``?name=value&…`` (``gs_usb:canable@1M?index=0``).  The name ``serial`` is the XtrapulsPac link, so
-python-can's own generic ``serial`` interface is not offered.  A spec is what the user types on the command line
+``serial:PORT_OR_URL[@BAUD]`` (the XtrapulsPac RS-232 link), ``profibus:PORT[@BAUD][?master=ADDR]`` (a PROFIBUS-DP
+line: a serial device or a pyserial URL such as ``socket://HOST:PORT``, ``tcp:HOST:PORT`` for short; the TTA-PRO) and
+``sim[:NODES]`` (simulated drives in this process, NODES as for ``servostudio sim``, e.g.
+``1:xtrapulspac,2:cd1k``).  Any other interface python-can knows — its built-in backends and the plugins installed
+beside it (``gs_usb:``, ``udp_multicast:``, ``vector:``, …) — is spelled the same way,
+``INTERFACE:CHANNEL[@BITRATE]``, and every kind takes the interface's own options as a query, ``?name=value&…``
+(``gs_usb:canable@1M?index=0``).  The name ``serial`` is the XtrapulsPac link, so python-can's own generic
+``serial`` interface is not offered.  A spec is what the user types on the command line
 and what the REST API takes, so the parser names the problem precisely.
 """
 
@@ -22,12 +24,17 @@ from can.interfaces import VALID_INTERFACES
 from servostudio.errors import InvalidInput
 
 #: kinds of our own; every other python-can interface is accepted as well (see ``known_kinds``)
-OWN_KINDS = ("socketcand", "serial", "sim")
+OWN_KINDS = ("socketcand", "serial", "profibus", "sim")
 #: interfaces whose bit rate is set outside the program (``ip link``, the other process), so '@' would mislead
 _WITHOUT_BITRATE = {"socketcan", "socketcand", "virtual", "udp_multicast", "sim"}
 _INTEGER_CHANNEL = {"ixxat", "kvaser"}
 SERIAL_BAUDRATES = (9600, 19200, 38400, 57600, 115200)
 DEFAULT_SERIAL_BAUDRATE = 19200
+#: the PROFIBUS-DP baud rates (EN 50170); without one the DP master's default, 1.5 Mbit/s
+PROFIBUS_BAUDRATES = (9600, 19200, 45450, 93750, 187500, 500000, 1500000, 3000000, 6000000, 12000000)
+DEFAULT_PROFIBUS_MASTER = 2
+#: DP master addresses: 0..125 (126 is the default address of an unset slave, 127 the broadcast)
+PROFIBUS_MASTERS = range(126)
 DEFAULT_SOCKETCAND_CHANNEL = "can0"
 DEFAULT_SIM_NODES = "1,2,3"
 _RATE = re.compile(r"^(\d+)([kKmM]?)$")
@@ -72,13 +79,21 @@ class BusSpec:
         text = f"{self.kind}:{self.channel}"
         return f"{text}@{self.bitrate}" if self.bitrate is not None else text
 
+    @property
+    def profibus_master(self) -> int:
+        """A ``profibus`` spec's master address (``?master=``, 2 by default)."""
+        return int(dict(self.options).get("master", DEFAULT_PROFIBUS_MASTER))
+
     def python_can_config(self) -> dict[str, Any]:
-        """Keyword arguments for ``can.Bus(**config)``; not available for ``sim`` (opened in-process).
+        """Keyword arguments for ``can.Bus(**config)``; not available for ``sim`` (opened in-process) nor for
+        ``profibus`` (no CAN bus: the DP master opens the line).
 
         The values are ``Any`` because ``can.Bus`` takes its interface options as ``**kwargs: Any``.
         """
         if self.kind == "sim":
             raise BusSpecError("the 'sim' bus is opened in-process, not through python-can")
+        if self.kind == "profibus":
+            raise BusSpecError("a 'profibus' bus is a PROFIBUS-DP line, not a CAN bus: python-can does not open it")
         return {**self._base_config(), **{name: _option_value(text) for name, text in self.options}}
 
     def _base_config(self) -> dict[str, Any]:
@@ -127,6 +142,8 @@ def parse_bus_spec(text: str) -> BusSpec:
     rest, options = _split_options(text, rest)
     if options and kind == "sim":
         raise BusSpecError(f"bus {text!r}: the simulated bus takes no options")
+    if kind == "profibus":
+        return replace(_parse_profibus(text, rest), options=_profibus_options(text, options))
     return replace(_parse_address(text, kind, rest, bool(colon)), options=options)
 
 
@@ -199,3 +216,36 @@ def _parse_sim(text: str, nodes: str) -> BusSpec:
         if not 1 <= node <= 127:
             raise BusSpecError(f"bus {text!r}: node {node} outside 1..127")
     return BusSpec(kind="sim", channel=nodes)
+
+
+def _parse_profibus(text: str, rest: str) -> BusSpec:
+    """``PORT[@BAUD]``: a serial device or pyserial URL; ``tcp:HOST:PORT`` is ``socket://HOST:PORT``."""
+    port, at, rate = rest.rpartition("@") if "@" in rest else (rest, "", "")
+    if not port:
+        raise BusSpecError(f"bus {text!r}: missing port after 'profibus:' (a serial device or socket://HOST:PORT)")
+    if port.lower().startswith("tcp:"):
+        port = "socket://" + port[4:]
+    if port.startswith("socket://"):
+        _check_tcp_address(text, port.removeprefix("socket://"))
+    baud = _split_bitrate(text, "profibus", f"x@{rate}")[1] if at else None
+    if baud is not None and baud not in PROFIBUS_BAUDRATES:
+        allowed = ", ".join(map(str, PROFIBUS_BAUDRATES))
+        raise BusSpecError(f"bus {text!r}: PROFIBUS baud rate {baud} not supported; use one of {allowed}")
+    return BusSpec(kind="profibus", channel=port, bitrate=baud)
+
+
+def _check_tcp_address(text: str, address: str) -> None:
+    host, colon, port_text = address.rpartition(":")
+    if not colon or not host or not port_text.isdigit() or not 0 < int(port_text) < 65536:
+        raise BusSpecError(f"bus {text!r}: expected socket://HOST:PORT (or tcp:HOST:PORT), PORT 1..65535")
+
+
+def _profibus_options(text: str, options: tuple[tuple[str, str], ...]) -> tuple[tuple[str, str], ...]:
+    """Only ``master=ADDR`` (0..125), kept as its number and left out when it is the default, so every spelling
+    of one line is one bus."""
+    for name, value in options:
+        if name != "master":
+            raise BusSpecError(f"bus {text!r}: a profibus bus takes only the option master=ADDR, not {name!r}")
+        if not value.isdigit() or int(value) not in PROFIBUS_MASTERS:
+            raise BusSpecError(f"bus {text!r}: master address {value!r} outside 0..125")
+    return tuple((name, str(int(value))) for name, value in options if int(value) != DEFAULT_PROFIBUS_MASTER)

@@ -169,11 +169,11 @@ describe("digital I/O", () => {
   it("lights the LEDs of the set bits of the live word and follows it", () => {
     const cell = state<number | null>(null);
     const element = digitalIo({ inputs, outputs: null, word: () => cell.val, address: () => "0x60FD,0" });
-    const leds = () => [...testid(element, "io-inputs")!.querySelectorAll(".led")].map((led) => `${led.textContent}${led.classList.contains("on") ? "*" : ""}`);
-    expect(leds()).toEqual(["LIM−", "IN1"]);
-    cell.val = 0x10000;
-    expect(leds()).toEqual(["LIM−", "IN1*"]);
-    expect(element.textContent).toContain("Inputs · 0x60FD,0 = 0x00010000");
+    const leds = (row: string) => [...testid(element, row)!.querySelectorAll(".led")].map((led) => `${led.textContent}${led.classList.contains("on") ? "*" : ""}`);
+    expect([leds("io-inputs"), leds("io-inputs-functions")]).toEqual([["IN1"], ["LIM−"]]);  // terminals; what the drive makes of them
+    cell.val = 0x10001;
+    expect([leds("io-inputs"), leds("io-inputs-functions")]).toEqual([["IN1*"], ["LIM−*"]]);
+    expect(element.textContent).toContain("Inputs · 0x60FD,0 = 0x00010001");
     expect(testid(element, "io-outputs")).toBeNull();
   });
 

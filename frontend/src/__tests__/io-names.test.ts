@@ -26,6 +26,7 @@ describe("the names of the I/O configuration", () => {
     expect(names.outputs.get(17)).toBe("OUT2");
     expect(configuredName("IN2: Positive limit switch")).toBe("IN2 LIM+");
     expect(configuredName("INPUT0 / LS+")).toBe("INPUT0");
+    expect(configuredName("INHIBIT: Inhibit")).toBe("INHIBIT");  // a terminal named after its function: once
     expect(lineLabel({ name: "IN9", function: "unknown", bit: 24 }, functions)).toBe("IN9: unknown");
   });
 

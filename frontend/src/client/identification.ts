@@ -13,8 +13,8 @@ import type { Schemas } from "./schema-types";
 
 export type IdentificationOptions = Schemas["IdentificationOptions"];
 
-/** The tuning after the identification (drives with gain objects): gains before → after in physical units and the
- * verification's speed step with its measured bandwidth. */
+/** The tuning after the identification (gain objects, or the encoTRive's inertia setting): gains before → after in
+ * physical units and the verification's speed step with its measured bandwidth. */
 export interface TuningAfterIdentification {
   bandwidth_hz: number;
   gains: { before: Record<string, unknown>; after: Record<string, unknown> };

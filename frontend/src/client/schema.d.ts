@@ -947,7 +947,7 @@ export interface paths {
         get?: never;
         put?: never;
         /**
-         * Find and identify every node (1–127; 1–63 on a serial link)
+         * Find and identify every node (1–127; 1–63 on a serial link; DP stations 3–125 on a PROFIBUS line)
          * @description An empty bus is an answer (200, ``[]``); the header then says why it may look empty.
          */
         post: operations["scan_bus_api_buses__bus__scan_post"];
@@ -2293,7 +2293,7 @@ export interface components {
             id?: string | null;
             /**
              * Spec
-             * @description bus spec: socketcan:can0, pcan:PCAN_USBBUS1@1000000, ixxat:0@500000, kvaser:0, slcan:/dev/ttyACM0@1000000, socketcand:HOST:PORT[/CH], virtual:NAME, serial:PORT_OR_URL[@BAUD], sim[:NODES]
+             * @description bus spec: socketcan:can0, pcan:PCAN_USBBUS1@1000000, ixxat:0@500000, kvaser:0, slcan:/dev/ttyACM0@1000000, socketcand:HOST:PORT[/CH], virtual:NAME, serial:PORT_OR_URL[@BAUD], profibus:PORT[@BAUD][?master=ADDR] (PORT a serial device, socket://HOST:PORT or tcp:HOST:PORT), sim[:NODES]
              */
             spec: string;
         };
@@ -4827,6 +4827,11 @@ export interface components {
              * @description the audit log the server appends to
              */
             audit_file: string;
+            /**
+             * Audit Old Values
+             * @description which drive writes the audit log reads the old value of first (`--audit-old-values`): `small-writes` (up to 16 objects at once) or `every-write`
+             */
+            audit_old_values: string;
             /** Builtin Eds Dir */
             builtin_eds_dir: string;
             /**
@@ -4990,6 +4995,8 @@ export interface components {
             current_filter_2_hz?: number | null;
             /** Current Filter 3 Hz */
             current_filter_3_hz?: number | null;
+            /** Inertia Setting Kgm2 */
+            inertia_setting_kgm2?: number | null;
             /** Ka A Per Rad S2 */
             ka_a_per_rad_s2?: number | null;
             /** Kb A Per Rad S */
@@ -5028,6 +5035,11 @@ export interface components {
              * @description KJv/256 (1 on a drive without multiplier)
              */
             gain_multiplier: number;
+            /**
+             * Inertia Setting Kgm2
+             * @description the inertia setting the drive derives its gains from (encoTRive Θi); null on other drives
+             */
+            inertia_setting_kgm2?: number | null;
             /** Kc A Per Rad S */
             kc_a_per_rad_s: number;
             /** Kd A Per Rad S2 */

@@ -11,6 +11,7 @@ import { buildPath } from "../lib/router";
 const SPEC_EXAMPLES = [
   "sim", "socketcan:can0", "pcan:PCAN_USBBUS1@1000000", "ixxat:0@500000", "kvaser:0",
   "slcan:/dev/ttyACM0@1000000", "socketcand:127.0.0.1:29536", "serial:/dev/ttyUSB0@19200",
+  "profibus:/dev/ttyUSB0@1500000",
 ];
 
 /** What the parts of the page share. */

@@ -1,6 +1,7 @@
-"""The TTA-PRO client (PKW request/response and PZD words over the cyclic Data_Exchange of the project's DP master)
-against the simulated slave over its TCP byte stream: reads, writes, refusals, a procedure, the enabling state
-machine, a lost and recovered line."""
+"""The TTA-PRO client (PKW request/response and PZD words over the cyclic Data_Exchange) against the simulated slave,
+through both DP masters — pyprofibus's DPM1 over the line's pseudo-terminal and the project's own over its TCP
+stream: reads, writes, refusals, a procedure, the enabling state machine, a lost and recovered station, a cut
+line."""
 
 from __future__ import annotations
 
@@ -8,17 +9,15 @@ import time
 from collections.abc import Callable, Iterator
 
 import pytest
+from tests.support.dp_masters import TRANSPORTS, dp_master, simulated_line
 
 from servostudio.drive.profibus.client import PkwTimeout, ProfibusLinkDown, TtaProClient
 from servostudio.drive.profibus.pkw import read_request
 from servostudio.drive.profibus.pkw_errors import PkwRefused
 from servostudio.drive.profibus.pzd import ENABLING_SEQUENCE, DriveState, drive_state
 from servostudio.errors import Conflict
-from servostudio.od.pnu import builtin_parameter_list
-from servostudio.sim.plant import Plant
 from servostudio.sim.profibus.endpoints import ProfibusTcpServer
 from servostudio.sim.profibus.line import ProfibusLine
-from servostudio.sim.profibus.slave import TtaProSlave
 from servostudio.transport.profibus.master import ByteLink, DpMaster
 
 ADDRESS = 5
@@ -26,26 +25,16 @@ ADDRESS = 5
 
 @pytest.fixture
 def line() -> Iterator[ProfibusLine]:
-    line = ProfibusLine([TtaProSlave(ADDRESS, builtin_parameter_list(), Plant.commissioned())])
-    line.start()
-    yield line
-    line.stop()
+    with simulated_line(ADDRESS) as line:
+        yield line
 
 
-@pytest.fixture
-def server(line: ProfibusLine) -> Iterator[ProfibusTcpServer]:
-    server = ProfibusTcpServer(line).start()
-    yield server
-    server.stop()
-
-
-@pytest.fixture
-def client(server: ProfibusTcpServer) -> Iterator[TtaProClient]:
-    master = DpMaster(ByteLink("socket://{}:{}".format(*server.address)))
-    client = TtaProClient(master, ADDRESS).start()
-    yield client
-    client.close()
-    master.close()
+@pytest.fixture(params=TRANSPORTS)
+def client(request: pytest.FixtureRequest, line: ProfibusLine) -> Iterator[TtaProClient]:
+    with dp_master(request.param, line) as master:
+        client = TtaProClient(master, ADDRESS).start()
+        yield client
+        client.close()
 
 
 def _eventually(condition: Callable[[], bool], seconds: float = 2.0) -> None:

@@ -45,10 +45,12 @@ class Bench(AxisBench):
             )
 
 
-def open_bench(plant: Plant, speed: float) -> Bench:
-    """One commissioned XtrapulsPac (node 1) on ``plant``: gains tuned for the plant as a machine in service has."""
+def open_bench(plant: Plant, speed: float, device: str = "xtrapulspac") -> Bench:
+    """One commissioned drive (node 1, an XtrapulsPac unless ``device`` says otherwise) on ``plant``: gains tuned for
+    the plant as a machine in service has."""
     network = SimulatedNetwork(
-        "1", behaviour_factory=lambda device, node, store, events: make_behaviour(device, store, plant, events, True)
+        f"1:{device}",
+        behaviour_factory=lambda device, node, store, events: make_behaviour(device, store, plant, events, True),
     )
     network.start(speed)
     manager, connection = connect(network, SDO_TIMEOUT)
@@ -59,8 +61,8 @@ def open_bench(plant: Plant, speed: float) -> Bench:
 def frequency_bench() -> Iterator[Callable[..., Bench]]:
     opened: list[Bench] = []
 
-    def make(plant: Plant, speed: float = 4.0) -> Bench:
-        opened.append(open_bench(free(plant), speed))
+    def make(plant: Plant, speed: float = 4.0, device: str = "xtrapulspac") -> Bench:
+        opened.append(open_bench(free(plant), speed, device))
         return opened[-1]
 
     yield make

@@ -81,10 +81,13 @@ def test_a_two_mass_plant_s_resonance_is_found(frequency_bench):
     )
 
 
-def step_bandwidth(plant: Plant, base: float = 15.0, delta: float = 2.0) -> float:
-    """The closed speed loop's −3 dB bandwidth from a PV step on the simulator: the shaft's speed every control
-    period, H(f) = DFT of the step response's derivative / step (its impulse response's transform)."""
-    store = ObjectStore(builtin_library().load("xtrapulspac"), 1)
+def step_bandwidth(
+    plant: Plant, base: float = 15.0, delta: float = 2.0, device: str = "xtrapulspac", per_rev: int = USER_PER_REV
+) -> float:
+    """The closed speed loop's −3 dB bandwidth from a PV step on the simulated ``device`` (``per_rev`` position
+    units per revolution): the shaft's speed every control period, H(f) = DFT of the step response's derivative /
+    step (its impulse response's transform)."""
+    store = ObjectStore(builtin_library().load(device), 1)
 
     class Events:
         flash_busy = False
@@ -94,9 +97,9 @@ def step_bandwidth(plant: Plant, base: float = 15.0, delta: float = 2.0) -> floa
 
         def emergency_cleared(self) -> None: ...
 
-    drive = make_behaviour("xtrapulspac", store, free(plant), Events(), True)
-    unit = TWO_PI / USER_PER_REV
-    for index, value in ((0x6083, USER_PER_REV * 5000), (0x6084, USER_PER_REV * 5000), (0x6060, 3)):
+    drive = make_behaviour(device, store, free(plant), Events(), True)
+    unit = TWO_PI / per_rev
+    for index, value in ((0x6083, per_rev * 5000), (0x6084, per_rev * 5000), (0x6060, 3)):
         store.write_from_bus(index, 0, value)
     for word in (0x06, 0x07, 0x0F):
         store.write_from_bus(0x6040, 0, word)

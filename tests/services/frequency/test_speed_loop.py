@@ -4,6 +4,7 @@ conversion of the raw objects, `sim.drive.behaviour`), writes through the server
 from __future__ import annotations
 
 from collections.abc import Iterator
+from dataclasses import replace
 
 import pytest
 from tests.services.procedures.conftest import open_bench
@@ -110,9 +111,28 @@ def test_cd1k_has_no_multiplier_filters_or_torque_constant(bus: tuple[BusConnect
         raw_writes(drive, {"current_filter_1_hz": 100})
 
 
-def test_a_drive_without_gain_objects_says_so(bus: tuple[BusConnection, SimulatedNetwork]) -> None:
+def test_the_encotrive_reads_as_the_gains_it_derives_from_its_inertia_setting(
+    bus: tuple[BusConnection, SimulatedNetwork],
+) -> None:
+    connection, network = bus
+    drive: Drive = connection.drive(3)
+    loop = read_speed_loop(drive)
+    kpv, kiv = _loops(network, 3).kpv, _loops(network, 3).kiv
+    assert loop["writable"] == ["inertia_setting_kgm2"] and loop["inertia_setting_kgm2"] > 0
+    assert loop["kp_a_per_rad_s"] == pytest.approx(kpv, rel=1e-6) and kpv > 0
+    assert loop["ki_a_per_rad"] == pytest.approx(kiv, rel=1e-6)
+    with pytest.raises(BadSpeedLoop, match="kp_a_per_rad_s not writable"):
+        raw_writes(drive, {"kp_a_per_rad_s": 1.0})
+    written = write_speed_loop(drive, {"inertia_setting_kgm2": 2 * loop["inertia_setting_kgm2"]})
+    assert written["written"] == [["speed_controller_inertia", 2 * loop["raw"]["speed_controller_inertia"]]]
+    assert _loops(network, 3).kpv == pytest.approx(2 * kpv, rel=1e-3)  # the simulated drive follows Θi
+    assert written["after"]["kp_a_per_rad_s"] == pytest.approx(2 * loop["kp_a_per_rad_s"], rel=1e-3)
+
+
+def test_a_drive_without_a_speed_loop_description_says_so(bus: tuple[BusConnection, SimulatedNetwork]) -> None:
     connection, _ = bus
     drive: Drive = connection.drive(3)
+    drive.profile = replace(drive.profile, speed_loop=None)  # a generic CiA 402 drive
     with pytest.raises(NoSpeedLoop, match="encotrive has no speed-loop gain objects"):
         read_speed_loop(drive)
     with pytest.raises(NoSpeedLoop):

@@ -3,6 +3,7 @@ probe (tests/sim/recorder_peer.py) as the reference for the recorded values."""
 
 from __future__ import annotations
 
+import contextvars
 import threading
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
@@ -10,6 +11,7 @@ from dataclasses import dataclass, field
 import pytest
 from tests.sim.recorder_peer import REV, Probe
 from tests.support.embedded_sim import open_sim
+from tests.support.motion import controlling
 
 from servostudio.drive.access import Drive
 from servostudio.drive.sdo import SdoNodeRestarted
@@ -71,7 +73,7 @@ class Background:
     _changed: threading.Condition = field(default_factory=threading.Condition)
 
     def start(self) -> Background:
-        threading.Thread(target=self._run, daemon=True).start()
+        threading.Thread(target=contextvars.copy_context().run, args=(self._run,), daemon=True).start()
         return self
 
     def _run(self) -> None:
@@ -115,7 +117,8 @@ def bench() -> Iterator[ScopeBench]:
         scope_bench = ScopeBench(manager.get("sim"))
         for node in (1, 2):
             _until_booted(scope_bench.drive(node))
-        yield scope_bench
+        with controlling(manager, "sim", (1, 2)):  # a capture's NMT start of an enabled axis needs its controller
+            yield scope_bench
     finally:
         manager.close_all()
 

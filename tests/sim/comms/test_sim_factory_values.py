@@ -11,6 +11,7 @@ from dataclasses import replace
 
 import pytest
 
+from servostudio.drive.profiles import profile_for
 from servostudio.od import builtin_library
 from servostudio.od.model import Variable
 from servostudio.sim.flash import DRIVEPAR, SAVE
@@ -18,7 +19,7 @@ from servostudio.sim.frame import Frame
 from servostudio.sim.network import SimulatedNetwork, drive_behaviour_factory
 from servostudio.sim.objects import undefined_default
 
-DEVICES = builtin_library().devices()
+DEVICES = [device for device in builtin_library().devices() if profile_for(device).canopen]  # the CAN simulator's
 
 
 class Recorder:

@@ -1,10 +1,13 @@
-"""A new simulated encoTRive holds the manual's ramps and speed limits, so a speed ramp move runs out of the box."""
+"""A new simulated encoTRive holds the manual's ramps and speed limits, so a speed ramp move runs out of the box,
+and the inertia setting its speed controller is computed from."""
 
 from __future__ import annotations
 
 import pytest
+from tests.support.shaft_step import encotrive_bandwidth
 
 from servostudio.sim.drive.encotrive import FACTORY_VALUES
+from servostudio.sim.plant import Plant
 
 
 def test_a_fresh_encotrive_has_no_zero_ramp_or_speed_limit(harness):
@@ -35,3 +38,16 @@ def test_factory_values_come_back_with_the_other_defaults(harness):
     h.write(0x6083, 0, 1)
     h.store.restore_defaults()
     assert h.read(0x6083) == 4000
+
+
+def test_the_speed_loop_follows_the_inertia_setting(harness):
+    """0x2F02,8 Θi (p. 218): the factory's is the rotor's own inertia; writing a larger one raises the speed loop's
+    bandwidth, measured on the true plant's shaft (Θi = J puts the crossover at ωd = 253 rad/s: about 53 Hz)."""
+    plant = Plant.from_seed(3)  # load 3.1 × the rotor
+    h = harness("encotrive", plant, False)
+    assert h.read(0x2F02, 8) == round(plant.motor_inertia / 1e-7)
+    true = round(plant.total_inertia / 1e-7)
+    bandwidths = [encotrive_bandwidth(plant, raw) for raw in (None, true // 2, true, 2 * true)]
+    assert bandwidths == sorted(bandwidths) and bandwidths[0] < 25
+    assert bandwidths[2] == pytest.approx(53, rel=0.1)
+    assert bandwidths[3] > 1.8 * bandwidths[2]

@@ -84,7 +84,7 @@ def close_bus(bus: str, manager: Connections) -> None:
 @router.post(
     "/{bus}/scan",
     response_model=list[NodeIdentity],
-    summary="Find and identify every node (1–127; 1–63 on a serial link)",
+    summary="Find and identify every node (1–127; 1–63 on a serial link; DP stations 3–125 on a PROFIBUS line)",
     responses={200: {"headers": {SCAN_HINT_HEADER: {"description": SCAN_HINT, "schema": {"type": "string"}}}}},
     dependencies=[Requires(Level.OPERATOR)],
 )

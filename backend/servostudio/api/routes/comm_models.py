@@ -16,7 +16,8 @@ class BusOpen(BaseModel):
     spec: str = Field(
         description="bus spec: socketcan:can0, pcan:PCAN_USBBUS1@1000000, ixxat:0@500000, kvaser:0, "
         "slcan:/dev/ttyACM0@1000000, socketcand:HOST:PORT[/CH], virtual:NAME, "
-        "serial:PORT_OR_URL[@BAUD], sim[:NODES]"
+        "serial:PORT_OR_URL[@BAUD], profibus:PORT[@BAUD][?master=ADDR] (PORT a serial device, socket://HOST:PORT "
+        "or tcp:HOST:PORT), sim[:NODES]"
     )
     id: str | None = Field(
         None, description="name of the bus in later calls (default: the bus kind, e.g. sim, socketcand, socketcand2, …)"

@@ -1,9 +1,10 @@
 """The frequency response of an axis (docs/frequency-response.md): ``POST …/frequency-response`` starts the
 measurement as a job (202, operation ``frequency-response``; ``progress`` events on /api/ws/events with ``stage``
 and ``fraction``; cancelling the job stops the axis).  Refused before anything is written: 422 a request the drive
-cannot take (no recorder, frequencies beyond the SYNC rate), 409 without the axis's armed controller
-(``X-Servo-Client``), 404 an unknown project or axis.  The job's result is the result dict; a limit exceeded ends it
-with ``aborted`` and no points.
+cannot take (frequencies beyond the SYNC rate; without a recorder, whose response then comes in synchronous
+TPDOs: a plant without a current actual value, a bus too slow for the SYNC rate's frames), 409 without the axis's
+armed controller (``X-Servo-Client``), 404 an unknown project or axis.  The job's result is the result dict; a limit
+exceeded ends it with ``aborted`` and no points.
 """
 
 from __future__ import annotations

@@ -135,9 +135,9 @@ async def _send_roll(socket: WebSocket, feed: RollFeed, receiver: asyncio.Task[N
     cursor = 0
     while not receiver.done():
         events, cursor = feed.since(cursor)
-        for event in events:
-            await socket.send_json(event)
-        if any(event["type"] == "end" for event in events):
+        for _, text in events:
+            await socket.send_text(text)  # encoded once by the feed for every socket following the roll
+        if any(event["type"] == "end" for event, _ in events):
             await socket.close()
             return
         await asyncio.sleep(ROLL_SEND_SECONDS)
@@ -180,7 +180,7 @@ def get_status(bus: str, drive: NodeDrive, scope: ScopeCaptures) -> dict:
     dependencies=[Requires(Level.OPERATOR)],
 )
 def force_trigger(bus: str, drive: NodeDrive, scope: ScopeCaptures) -> dict:
-    scope.force(drive)
+    scope.force(drive, bus)
     return scope.status(bus, drive)
 
 

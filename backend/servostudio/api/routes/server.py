@@ -31,6 +31,10 @@ class ServerSettingsModel(BaseModel):
     export_dir: str | None = Field(description="where backup and restore jobs may also write (`--export-dir`)")
     data_dir: str = Field(description="users, tokens and the audit log (`--data-dir`, `SERVOSTUDIO_DATA_DIR`)")
     audit_file: str = Field(description="the audit log the server appends to")
+    audit_old_values: str = Field(
+        description="which drive writes the audit log reads the old value of first (`--audit-old-values`): "
+        "`small-writes` (up to 16 objects at once) or `every-write`"
+    )
     builtin_eds_dir: str
     user_eds_dir: str = Field(description="where imported EDS files go")
     motors_dir: str
@@ -55,6 +59,7 @@ def shown(settings: Settings, passwordless: bool) -> dict[str, object]:
         "export_dir": str(settings.export_dir) if settings.export_dir is not None else None,
         "data_dir": str(settings.data_dir),
         "audit_file": str(settings.audit_path),
+        "audit_old_values": settings.audit_old_values,
         "builtin_eds_dir": str(settings.builtin_eds_dir),
         "user_eds_dir": str(settings.user_eds_dir),
         "motors_dir": str(settings.motors_dir),

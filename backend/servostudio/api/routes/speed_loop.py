@@ -2,7 +2,8 @@
 
 ``GET …/speed-loop`` reads the gains and filters converted through the device profile; ``PUT …/speed-loop`` writes
 the physical values given (the what-if page's "write these gains"), every value checked before anything is sent,
-through the drive's gate.  A drive without gain objects (encoTRive) answers 404.
+through the drive's gate.  The encoTRive reads as the gains it derives from its inertia setting and takes only
+``inertia_setting_kgm2``; a drive without a speed-loop description answers 404.
 """
 
 from __future__ import annotations

@@ -28,6 +28,10 @@ class SpeedLoopModel(BaseModel):
         default=[], description="the speed-filter time constants a PUT takes (empty: the filter is fixed)"
     )
     writable: list[str] = Field(description="the keys a PUT takes on this drive")
+    inertia_setting_kgm2: float | None = Field(
+        default=None,
+        description="the inertia setting the drive derives its gains from (encoTRive Θi); null on other drives",
+    )
     raw: dict[str, int] = Field(description="semantic object name → raw value read")
 
 
@@ -47,6 +51,7 @@ class SpeedLoopChange(BaseModel):
     current_filter_2_hz: float | None = _GAIN
     current_filter_3_hz: float | None = _GAIN
     speed_filter_s: float | None = _GAIN
+    inertia_setting_kgm2: float | None = _GAIN
 
     def values(self) -> dict[str, float]:
         return {key: value for key, value in self.model_dump().items() if value is not None}

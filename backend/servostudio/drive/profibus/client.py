@@ -1,6 +1,6 @@
 """The TTA-PRO's PPO seen as a request/response API: PNU reads and writes through the PKW handshake, the control
-word out and the status word in through PZD, all riding the cyclic Data_Exchange of the DP master
-(`servostudio.transport.profibus.cyclic`; docs/profibus.md §6).
+word out and the status word in through PZD, all riding the cyclic Data_Exchange of a DP master
+(`servostudio.transport.profibus.interface.DpLine`: pyprofibus's DPM1 or the project's own; docs/profibus.md §7).
 
 `read`/`write` block until their reply, like an SDO upload/download; a reply that does not come in time, or a link
 lost meanwhile, abandons the request (AK 0 goes out, so a late reply cannot answer the next one) and raises.
@@ -15,8 +15,8 @@ from servostudio.drive.profibus.pkw import PkwMessage, read_request, write_reque
 from servostudio.drive.profibus.pkw_handshake import PkwChannel, reply_value
 from servostudio.drive.profibus.pzd import pack_words, unpack_words
 from servostudio.errors import ServoStudioError, Timeout, Unavailable
-from servostudio.transport.profibus.cyclic import PERIOD, WATCHDOG, CyclicExchange
-from servostudio.transport.profibus.master import DpMaster
+from servostudio.transport.profibus.cyclic import PERIOD, WATCHDOG
+from servostudio.transport.profibus.interface import DataExchange, DpLine
 from servostudio.transport.profibus.ppo import PKW_WORDS, PPO2, WORD_BYTES, Ppo
 
 PKW_TIMEOUT = 1.0
@@ -37,7 +37,7 @@ class TtaProClient:
     """One TTA-PRO in data exchange with this master."""
 
     def __init__(
-        self, master: DpMaster, address: int, ppo: Ppo = PPO2, period: float = PERIOD, watchdog: float | None = WATCHDOG
+        self, master: DpLine, address: int, ppo: Ppo = PPO2, period: float = PERIOD, watchdog: float | None = WATCHDOG
     ) -> None:
         if not ppo.has_pkw:
             raise ValueError(f"{ppo.name} has no PKW channel: the tool needs PPO1 or PPO2")
@@ -49,8 +49,10 @@ class TtaProClient:
         self._outputs = [0] * ppo.pzd_words
         self._inputs: tuple[int, ...] = (0,) * ppo.pzd_words
         self._link_error: ServoStudioError | None = None
-        self.exchange = CyclicExchange(
-            master, address, ppo, self._output_image, self._input_image, self._on_link, period, watchdog
+        self._sent = 0  # output images composed so far
+        self._answered = 0  # the output image the latest input image answered
+        self.exchange: DataExchange = master.exchange(
+            address, ppo, self._output_image, self._input_image, self._on_link, period, watchdog
         )
 
     def start(self) -> TtaProClient:
@@ -77,6 +79,33 @@ class TtaProClient:
         """PZD `word` (0 = STW) of every following output image."""
         with self._condition:
             self._outputs[word] = value & 0xFFFF
+
+    def output(self, word: int) -> int:
+        """PZD `word` as the following output images carry it."""
+        with self._condition:
+            return self._outputs[word]
+
+    def send_output(self, word: int, value: int, timeout: float = PKW_TIMEOUT) -> None:
+        """Set PZD `word` and return once the slave answered the Data_Exchange after the first one that carried it
+        (a master may hand over one exchange's reply late): two writes in a row (a fault acknowledge's edge, an
+        enabling step) each reach the drive, none is lost between two cycles."""
+        with self._condition:
+            self._outputs[word] = value & 0xFFFF
+            carried_by = self._sent + 2
+            self._wait_process_data(lambda: self._answered >= carried_by, f"PZD{word + 1} output", timeout)
+
+    def current_input(self, word: int, timeout: float = PKW_TIMEOUT) -> int:
+        """PZD `word` of the latest input image, waiting for the first one after the exchange started."""
+        with self._condition:
+            self._wait_process_data(lambda: self._answered > 0, f"PZD{word + 1} input", timeout)
+            return self._inputs[word]
+
+    def _wait_process_data(self, done: Callable[[], bool], what: str, timeout: float) -> None:
+        ready = self._condition.wait_for(lambda: done() or self._link_error is not None, timeout)
+        if self._link_error is not None:
+            raise ProfibusLinkDown(f"{what}: {self._link_error}")
+        if not ready:
+            raise PkwTimeout(f"{what}: no Data_Exchange with station {self.address} within {timeout:g} s")
 
     # -- parameters -------------------------------------------------------------------------------------------
 
@@ -120,12 +149,15 @@ class TtaProClient:
 
     def _output_image(self) -> bytes:
         with self._condition:
+            self._sent += 1
             return self._channel.output().encode() + pack_words(self._outputs)
 
     def _input_image(self, data: bytes) -> None:
         reply = PkwMessage.decode(data[:PKW_BYTES])
         with self._condition:
             self._inputs = unpack_words(data[self.ppo.pzd_offset :])
+            self._answered = self._sent
+            self._condition.notify_all()
             completed = self._channel.receive(reply)
             if completed is not None:
                 self._reply = completed

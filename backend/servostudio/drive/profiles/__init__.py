@@ -9,9 +9,10 @@ from __future__ import annotations
 from servostudio.drive.profiles.base import DeviceProfile, ProfileError, generic_profile, signature_value
 from servostudio.drive.profiles.cd1k import CD1K
 from servostudio.drive.profiles.encotrive import ENCOTRIVE
+from servostudio.drive.profiles.ttapro import TTAPRO
 from servostudio.drive.profiles.xtrapulspac import XTRAPULSPAC
 
-PROFILES: dict[str, DeviceProfile] = {profile.device: profile for profile in (XTRAPULSPAC, CD1K, ENCOTRIVE)}
+PROFILES: dict[str, DeviceProfile] = {profile.device: profile for profile in (XTRAPULSPAC, CD1K, ENCOTRIVE, TTAPRO)}
 
 
 def profile_for(device: str | None) -> DeviceProfile:

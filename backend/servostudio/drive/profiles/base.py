@@ -98,6 +98,9 @@ CIA402_MOTION_OBJECTS: frozenset[str] = frozenset(
 )
 
 
+CANOPEN = "CANopen"
+
+
 class EmcyLayout(enum.StrEnum):
     """How a device fills the manufacturer bytes 3..7 of its EMCY frames."""
 
@@ -183,6 +186,27 @@ class DeviceProfile:
     #: drive does not count them in position units per second (encoTRive: rpm and rpm/s); None: position units
     speed_unit_rad_s: float | None = None
     acceleration_unit_rad_s2: float | None = None
+    #: the fieldbus the drive speaks: CANopen (SDO, PDO, SYNC, NMT), or PROFIBUS-DP (PKW parameters and PZD control
+    #: words: none of CANopen's streams, ``drive/profibus/``)
+    fieldbus: str = "CANopen"
+    #: procedures started by writing a number instead of a 4-character signature: name → (semantic object, value)
+    procedure_values: Mapping[str, tuple[str, int]] = field(default_factory=dict)
+    #: the object whose value (in A, physical) the ‰ of the current actual value 0x6078 refer to
+    current_reference: str = "rated_current"
+    #: bits every device-control command carries besides CiA 402's bits 0-3 and 7 (``drive.control``): the TTA-PRO's
+    #: 0x0430 (control by PROFIBUS, no stop, no intermediate stop: without them it stays in local mode or stops)
+    controlword_fixed: int = 0
+    #: a CiA 402 command (``drive.cia402.Command`` value) → the bits 0-3 and 7 the device needs for it instead: the
+    #: TTA-PRO's OFF1 outranks OFF3 (L596-599), so its quick stop keeps ON set (0x0003, still Quick stop to CiA 402)
+    controlword_commands: Mapping[int, int] = field(default_factory=dict)
+    #: control-word bits that jog the axis + and − at ``jog_speed`` rpm while set (the TTA-PRO's CW8 / CW9); None:
+    #: the quick test jogs in CiA 402 profile velocity (``services.motion.jog``)
+    jog_bits: tuple[int, int] | None = None
+
+    @property
+    def canopen(self) -> bool:
+        """The drive has CANopen's PDOs, SYNC, NMT and SDO block transfers."""
+        return self.fieldbus == CANOPEN
 
     def address(self, name: str) -> tuple[int, int]:
         try:
@@ -203,6 +227,9 @@ class DeviceProfile:
 
     def signature(self, procedure: str) -> tuple[tuple[int, int], int]:
         """``((index, sub), value)`` to write to start a procedure such as "save"."""
+        if procedure in self.procedure_values:
+            object_name, value = self.procedure_values[procedure]
+            return self.address(object_name), value
         try:
             object_name, text = self.signatures[procedure]
         except KeyError:

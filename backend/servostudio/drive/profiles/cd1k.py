@@ -174,6 +174,9 @@ CD1K = DeviceProfile(
         "digital_outputs": (0x60FE, 1),
         "digital_output_mask": (0x60FE, 2),
         "velocity_demand": (0x606B, 0),
+        # 0x6078 in ‰ of the drive's current rating 6510h/4 (0.01 A), not of a motor rated current (docs/devices.md §9)
+        "current_actual": (0x6078, 0),
+        "drive_rating": (0x6510, 4),
         "encoder_increments": (0x608F, 1),
         **CD1K_IO_OBJECTS,
     },
@@ -198,6 +201,7 @@ CD1K = DeviceProfile(
     },
     procedures=CD1K_PROCEDURES,
     speed_loop=CD1K_SPEED_LOOP,
+    current_reference="drive_rating",
     homing_methods=HOMING_METHODS,
     motion_objects=CIA402_MOTION_OBJECTS | CD1K_IO_MOTION_OBJECTS,
     io=CD1K_IO,

@@ -19,6 +19,8 @@ from servostudio.drive.profiles.base import (
     DeviceProfile,
 )
 from servostudio.drive.profiles.io import ENCOTRIVE_IO
+from servostudio.drive.profiles.procedures import ProcedureSet, UserUnits
+from servostudio.drive.profiles.speed_loop import ENCOTRIVE_SPEED_LOOP
 
 _EMCY = {
     info.cia402_code: info
@@ -62,6 +64,18 @@ _RAMP_LIMITS = ("profile_acceleration", "max_acceleration", "profile_deceleratio
 
 _RPM = 2.0 * math.pi / 60.0
 
+_VERIFICATION_OBJECTS = (
+    "modes_of_operation",
+    "target_velocity",
+    "target_position",
+    "profile_velocity",
+    "profile_acceleration",
+    "profile_deceleration",
+    "max_profile_velocity",
+    "max_acceleration",
+    "max_deceleration",
+)
+
 ENCOTRIVE = DeviceProfile(
     device="encotrive",
     objects={
@@ -77,6 +91,8 @@ ENCOTRIVE = DeviceProfile(
         "encoder_increments": (0x608F, 1),
         "position_factor_numerator": (0x6093, 1),
         "position_factor_denominator": (0x6093, 2),
+        # Θi, from which the drive computes its speed controller (p. 218; index: decisions.md §6)
+        "speed_controller_inertia": (0x2F02, 8),
     },
     signatures={"save": ("store_parameters", "save"), "load": ("restore_parameters", "load")},
     emcy_codes=_EMCY,
@@ -90,4 +106,11 @@ ENCOTRIVE = DeviceProfile(
         3: ("max_profile_velocity", *_RAMP_LIMITS),
     },
     io=ENCOTRIVE_IO,
+    #: no procedures; what a tuning's verification step changes, restored after it
+    procedures=ProcedureSet(
+        {},
+        units=UserUnits("encoder_increments", "position_factor_numerator", "position_factor_denominator"),
+        verification_objects=_VERIFICATION_OBJECTS,
+    ),
+    speed_loop=ENCOTRIVE_SPEED_LOOP,
 )

@@ -68,6 +68,9 @@ XTRAPULSPAC_RECORDER = RecorderDescription(
         "trigger_record": (0x5840, 3),
         "records": (0x5840, 4),
         "part": (0x5841, 0),
+        # what another drive's TPDO sets for this recorder to trigger on (a triggered capture of several axes,
+        # docs/scope.md §7): 0x23A0 TPDO count acts only on TPDOs of transmission type 254, and only at a SYNC
+        "trigger_relay": (0x23A0, 0),
     },
     channel_sources=0x5811,
     channel_types=0x5810,

@@ -7,6 +7,7 @@ with this description only, so a new drive family describes its gains here and n
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 
@@ -18,6 +19,37 @@ class GainScale:
     object: str
     unit: float
     scaled: bool = True
+
+
+@dataclass(frozen=True)
+class InertiaSetting:
+    """A speed controller whose gains the drive derives itself from an inertia setting Θi (the encoTRive's
+    0x2F02,8, p. 218; docs/identification.md § Tuning): with Kt = rated torque / rated current and the design
+    crossover ωd = 1/((2π)²·Tc), KPv = Θi·ωd/Kt, KIv = KPv·ωd/``integral_divisor``, KAv = Θi/Kt, so the loop's
+    crossover is (Θi/J)·ωd."""
+
+    object: str
+    #: kg·m² per count
+    unit_kgm2: float
+    #: Tc = 1/fc, the current controller's cycle in s
+    cycle_s: float
+    #: the motor rated torque (a count is ``rated_torque_unit`` N·m) and rated current (``rated_current_unit`` A)
+    rated_torque: str
+    rated_current: str
+    rated_torque_unit: float = 1e-3
+    rated_current_unit: float = 1e-3
+    integral_divisor: float = 8.0
+    #: κ of this loop, (bandwidth Hz, κ) with the crossover ωc = κ·2π·bandwidth, linear between, held beyond: its
+    #: PI zero is fixed at ωd/8, not at ωc/4 as auto-tuning's rule has it (measured on the simulated encoTRive,
+    #: hidden plants, from the shaft's step response; docs/identification.md)
+    crossover_factors: tuple[tuple[float, float], ...] = (
+        (20.0, 0.70), (30.0, 0.75), (40.0, 0.77), (65.0, 0.76), (85.0, 0.72), (110.0, 0.66), (140.0, 0.62)
+    )  # fmt: skip
+
+    @property
+    def design_crossover(self) -> float:
+        """ωd in rad/s."""
+        return 1.0 / ((2.0 * math.pi) ** 2 * self.cycle_s)
 
 
 @dataclass(frozen=True)
@@ -40,6 +72,8 @@ class SpeedLoopDescription:
     torque_constant: str | None = None
     torque_constant_unit: float = 1e-3
     control_period_s: float = 250e-6
+    #: the gains are the drive's own function of this inertia setting (no gain objects); None: they are objects
+    inertia_setting: InertiaSetting | None = None
 
 
 #: the gain keys of the XtrapulsPac (docs/control-loops.md §2)
@@ -73,4 +107,12 @@ CD1K_SPEED_LOOP = SpeedLoopDescription(
         "kb_a_per_rad_s": GainScale("kb_position", 1e-4),
         "ka_a_per_rad_s2": GainScale("ka_position", 1e-6),
     },
+)
+
+#: the encoTRive: no gain objects, the drive derives its speed controller from the inertia setting Θi
+#: (0x2F02,8 in 1e-7 kg·m², Tc = 100 µs: fc = 10 kHz, p. 219) and the motor rating 6076h (mN·m) / 6075h (mA);
+#: its speed-measurement filter is fixed (the default 0.5 ms)
+ENCOTRIVE_SPEED_LOOP = SpeedLoopDescription(
+    gains={},
+    inertia_setting=InertiaSetting("speed_controller_inertia", 1e-7, 1e-4, "rated_torque", "rated_current"),
 )

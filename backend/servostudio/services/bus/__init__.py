@@ -1,5 +1,6 @@
 """The communication server's bus side: open buses (ConnectionManager), the event hub, background jobs."""
 
+from servostudio.services.bus.claims import BusClaims, Claimed
 from servostudio.services.bus.connections import (
     BusConnection,
     BusMatch,
@@ -13,9 +14,11 @@ from servostudio.services.bus.jobs import Job, JobRegistry, UnitResults
 from servostudio.services.bus.share import BusShare, ShareRefused, ShareStatus
 
 __all__ = [
+    "BusClaims",
     "BusConnection",
     "BusMatch",
     "BusShare",
+    "Claimed",
     "ConnectionManager",
     "EventHub",
     "Job",

@@ -18,21 +18,27 @@ import can
 from servostudio.drive.access import OPEN_GATE, Drive, WriteGate
 from servostudio.drive.link import BusLink
 from servostudio.drive.monitor import BusMonitor
-from servostudio.drive.nmt import NmtCommand, send_nmt
+from servostudio.drive.nmt import NmtCommand, NmtHeard, guard_nmt, send_nmt
+from servostudio.drive.profibus.engine import PkwEngine
+from servostudio.drive.profibus.link import ProfibusLink, refusal
 from servostudio.drive.profiles import DeviceProfile, profile_for
 from servostudio.drive.sdo import SdoEngine
 from servostudio.errors import Conflict, InvalidInput, NotFound, ServoStudioError
 from servostudio.od.library import EdsLibrary, builtin_library
+from servostudio.od.pnu_model import ParameterDictionary
+from servostudio.services.bus.claims import BusClaims
 from servostudio.services.bus.events import EventHub
 from servostudio.services.bus.share import BusShare, NotShared, ShareStatus
 from servostudio.services.bus.statewatch import StatuswordWatch
 from servostudio.services.motion import MotionGuard
 from servostudio.transport.open import open_bus
+from servostudio.transport.profibus.open import open_dp_line
 from servostudio.transport.spec import BusSpec, parse_bus_spec
 
 SERIAL_SDO_TIMEOUT = 1.0  # at 19200 baud a request and its answer alone take 12.5 ms, a forwarded one more
 CAN_SDO_TIMEOUT = 0.5
 DEFAULT_SHARE_HOST = "127.0.0.1"
+TTAPRO = "ttapro"
 
 
 class UnknownBusOrNode(NotFound):
@@ -74,6 +80,12 @@ class BusAlreadyOpen(Conflict):
     """The spec asked for under a new name is open already, under its own name."""
 
 
+def parameter_list(library: EdsLibrary, info: NodeInfo | None) -> ParameterDictionary | None:
+    """The PNUs of a PROFIBUS node: its device's parameter list (the TTA-PRO's until a scan said otherwise)."""
+    dictionary = library.load(info.device if info is not None and info.device else TTAPRO)
+    return dictionary if isinstance(dictionary, ParameterDictionary) else None
+
+
 class Simulation(Protocol):
     def stop(self) -> None: ...
 
@@ -113,6 +125,8 @@ class BusConnection:
     monitor: BusMonitor | None = None
     share: BusShare | None = None  # its socketcand endpoint for the user's own scripts, when shared
     motion: MotionGuard | None = None  # judges and logs its NMT commands (the manager's guard)
+    #: the nodes and the SYNC its running jobs hold (captures, rolls, frequency responses, identifications)
+    claims: BusClaims = field(init=False, repr=False)
     _identifying: dict[int, threading.Lock] = field(default_factory=dict, repr=False)
     _identifying_guard: threading.Lock = field(default_factory=threading.Lock, repr=False)
 
@@ -145,22 +159,26 @@ class BusConnection:
                 info = identify(self, node)
         return info.device if info else None
 
+    def __post_init__(self) -> None:
+        self.claims = BusClaims(self.id)
+        if self.motion is not None:
+            guard_nmt(self.link, self._judge_nmt)
+
     def nmt(self, command: str, node: int = 0) -> NmtCommand:
         """Send an NMT command named as the CLI and REST name it (``start``, ``reset-node``, …); node 0: all.
-
-        A start can make an axis move and a reset stop it, so the motion guard judges the command for every node
-        it addresses (node 0: every node a scan found) and logs it, as it does writes (``docs/motion-safety.md``)."""
+        A PROFIBUS line has no NMT: refused before the motion guard is asked about a command nobody would hear."""
         parsed = NmtCommand.parse(command)
-        heard = self.motion.admit_nmt(self.id, parsed, self._nmt_targets(node)) if self.motion else None
-        try:
-            send_nmt(self.link, parsed, node)
-        except ServoStudioError as error:
-            if heard is not None:
-                heard(error)
-            raise
-        if heard is not None:
-            heard(None)
+        if isinstance(self.link, ProfibusLink):
+            raise refusal(self.id, "an NMT command")
+        send_nmt(self.link, parsed, node)
         return parsed
+
+    def _judge_nmt(self, command: NmtCommand, node: int) -> NmtHeard:
+        """A start can make an axis move and a reset stop it, so the motion guard judges every NMT command sent on
+        this bus — by anyone — for every node it addresses (node 0: every node a scan found) and logs it, as it
+        does writes (``docs/motion-safety.md``)."""
+        assert self.motion is not None
+        return self.motion.admit_nmt(self.id, command, self._nmt_targets(node))
 
     def _nmt_targets(self, node: int) -> list[tuple[int, Drive, str | None]]:
         """The nodes an NMT command to ``node`` reaches, with their drives and NMT states (none when out of range:
@@ -241,6 +259,8 @@ class ConnectionManager:
             bus_id = bus_id or self._free_id(spec.kind)
             if bus_id in self._buses:
                 raise BusNameTaken(f"a bus named {bus_id!r} is already open")
+        if spec.kind == "profibus":
+            return self._open_profibus(spec, bus_id)
         opener, simulation = self._opener(spec)
         link = BusLink(bus_id, opener)
         timeout = SERIAL_SDO_TIMEOUT if spec.kind == "serial" else CAN_SDO_TIMEOUT
@@ -265,6 +285,27 @@ class ConnectionManager:
         with self._lock:
             self._buses[bus_id] = connection
         link.start(wait)
+        return connection
+
+    def _open_profibus(self, spec: BusSpec, bus_id: str) -> BusConnection:
+        """A PROFIBUS-DP line (docs/profibus.md §9): its drives are ordinary `Drive`s on their parameter list with
+        the PKW engine in place of the SDO engine; no bus monitor (no CAN frames to watch). The master is the line's
+        (`open_dp_line`: pyprofibus for a serial device, the project's own for a TCP stream). A line that cannot be
+        opened is refused at once (`DpLinkError`, 503): there is no interface to wait for."""
+        link = ProfibusLink(bus_id, open_dp_line(spec))
+        connection = BusConnection(
+            bus_id,
+            spec,
+            link,
+            PkwEngine(link, lambda node: parameter_list(self.library, connection.nodes.get(node))),
+            self.library,
+            self.events,
+            gate=self.motion.gate(bus_id),
+            motion=self.motion,
+        )
+        with self._lock:
+            self._buses[bus_id] = connection
+        link.start()
         return connection
 
     def _free_id(self, kind: str) -> str:

@@ -99,6 +99,36 @@ def update_phase(samples: Sequence[float], hold: int) -> int:
     return max(range(hold), key=counts.__getitem__)
 
 
+def monitored_lines(
+    samples: Sequence[float], harmonics: Sequence[int], block: int, spacing: int, hold: int
+) -> list[Lines]:
+    """The lines of a signal the drive takes every ``hold`` control periods (0x6078: every 1 ms, the current of the
+    period before), sampled every ``spacing = hold − 1`` periods (the 0.75-ms SYNC: 3 of 250 µs).  In every ``hold``
+    samples one falls where no new value came (it repeats the one before): where it falls places the samples in
+    the drive's update grid, and each sample that brought a new value is taken at the instant that value was
+    measured — comparable with a line of ``block`` samples at the SYNC instants.  A signal that changes at every
+    sample (a drive that takes it at the SYNC) is taken at the sample instants."""
+    if hold != spacing + 1:
+        raise ValueError(f"a sample every {spacing} periods of a value taken every {hold}: not the SYNC's pattern")
+    changes = [0] * hold
+    for i in range(1, len(samples)):
+        changes[i % hold] += samples[i] != samples[i - 1]
+    repeat = min(range(hold), key=changes.__getitem__)
+    if 4 * changes[repeat] > max(changes):
+        return block_lines(samples, harmonics, block)
+    first = (hold - 1 - spacing * repeat) % hold  # sample 0's control period in the update grid
+    rows = []
+    for start in range(0, len(samples) // block * block, block):
+        taken = [
+            (spacing * (k - start) - (first + spacing * k) % hold - 1, samples[k])
+            for k in range(start, start + block)
+            if k % hold != repeat
+        ]
+        turns = [-2j * math.pi * harmonic / (spacing * block) for harmonic in harmonics]
+        rows.append([hold / spacing * sum(value * cmath.exp(turn * t) for t, value in taken) for turn in turns])
+    return rows
+
+
 def speed_lines(positions: list[Lines], frequencies_hz: Sequence[float]) -> list[Lines]:
     """jω·X: the shaft speed's lines from the position's."""
     return [[2j * math.pi * f * x for x, f in zip(row, frequencies_hz, strict=True)] for row in positions]

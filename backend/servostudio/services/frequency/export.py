@@ -104,7 +104,7 @@ def _facts(result: Mapping[str, Any]) -> list[tuple[str, str]]:
     excitation = result.get("excitation") or {}
     facts = [
         ("loop", LOOPS.get(str(result.get("loop")), str(result.get("loop")))),
-        ("magnitude", _meaning(str(result.get("loop")))),
+        ("magnitude", _meaning(result)),
         ("drive", f"{result.get('device', '')} node {result.get('node', '')}"),
         ("axis", str(result.get("axis") or "")),
         ("measured (UTC)", str(result.get("time") or "")),
@@ -121,9 +121,11 @@ def _facts(result: Mapping[str, Any]) -> list[tuple[str, str]]:
     return facts
 
 
-def _meaning(loop: str) -> str:
-    if loop == "plant":
-        return "dB of (velocity in rad/s) / (torque in N·m)"
+def _meaning(result: Mapping[str, Any]) -> str:
+    """The magnitude's unit: a plant per N·m, or per A where the drive gave no torque constant (``input``)."""
+    if result.get("loop") == "plant":
+        per_ampere = (result.get("excitation") or {}).get("input") == "current"
+        return f"dB of (velocity in rad/s) / ({'current in A' if per_ampere else 'torque in N·m'})"
     return "dB of actual / demanded velocity"
 
 

@@ -27,16 +27,18 @@ from servostudio.drive.control import set_state
 from servostudio.drive.link import BusLink
 from servostudio.errors import InvalidInput, ServoStudioError
 from servostudio.services.cancel import Cancellation, Cancelled
-from servostudio.services.frequency import estimate, markers
+from servostudio.services.frequency import estimate, markers, tpdo_source
 from servostudio.services.frequency.excitation import Multisine, design
 from servostudio.services.frequency.speed_loop import NoSpeedLoop, read_speed_loop
 from servostudio.services.frequency.stream import ExcitationStream
+from servostudio.services.frequency.tpdo_source import ResponsePlan, ResponseStream, plan_response
 from servostudio.services.procedures.run import disable, read_values, restore
 from servostudio.services.procedures.units import TWO_PI, units_per_revolution
 from servostudio.services.scope import Capture, CaptureDefinition, CapturePlan, DriveIdentity, NoRecorder
 from servostudio.services.scope.capture import build_capture
 from servostudio.services.scope.recorder import RecorderSession, UploadFailed
 from servostudio.services.scope.service import check, record_once, session_of
+from servostudio.services.scope.stream import StreamFailed
 
 log = logging.getLogger(__name__)
 LOOPS = ("plant", "closed")
@@ -60,10 +62,26 @@ CURRENT_LATENCY_S = 250e-6
 #: the loop then only holds the base speed (crossover ≈ 1/30 of the tuned one, below the lowest line), so the
 #: torque excitation reaches the shaft instead of being cancelled by the loop (docs/frequency-response.md §3)
 SOFTEN = 30.0
-#: line amplitudes ∝ f^tilt (excitation.py)
-TILT = {"plant": 0.0, "closed": 0.5}
+#: what the excitation drives, by loop and source: the torque offset (the recorder's plant) or the target velocity
+EXCITED = {("plant", "recorder"): "torque_offset", ("plant", "tpdo"): "target_velocity",
+           ("closed", "recorder"): "target_velocity", ("closed", "tpdo"): "target_velocity"}  # fmt: skip
+#: line amplitudes ∝ f^tilt (excitation.py), by loop and source
+TILT = {("plant", "recorder"): 0.0, ("plant", "tpdo"): -0.25, ("closed", "recorder"): 0.5, ("closed", "tpdo"): 0.5}
+#: plant: % of the rated current; closed loop: % of the base speed
 DEFAULT_AMPLITUDE_PCT = {"plant": 50.0, "closed": 40.0}
+#: a velocity excitation of the plant swings the speed by at most this share of the base speed (never near zero)
+MAX_SWING = 0.8
+#: control periods per SYNC: the 1-ms current monitor (CURRENT_HOLD periods) against the 0.75-ms SYNC
+SYNC_PERIODS = 3
+#: the TPDO response may take this many times its ideal duration plus RESPONSE_MARGIN_S before the run gives up
+RESPONSE_STRETCH, RESPONSE_MARGIN_S = 3.0, 10.0
+#: a period of the TPDO response is dropped (and another one taken) when two of its SYNCs, or of the RELOCK_SYNCS
+#: before it, left more than STALL_S apart: a drive locked to the SYNC lost it and takes some to lock again (the
+#: simulator unlocks after 0.25 s of silence and locks again after 32 SYNCs; docs/frequency-response.md §8)
+STALL_S, RELOCK_SYNCS = 0.1, 64
 SETTLE_S = 0.4
+#: what the watch checks
+WATCHED = ("position_actual", "current_actual")
 WATCH_S = 0.05
 STOP_WAIT_S = 1.5
 RECORDING_TIMEOUT_S = 10.0
@@ -94,10 +112,16 @@ class MeasureRequest:
         return self.amplitude_pct if self.amplitude_pct is not None else DEFAULT_AMPLITUDE_PCT[self.loop]
 
 
-def check_request(drive: Drive, request: MeasureRequest) -> Multisine:
+def source_of(drive: Drive) -> str:
+    """Where the response comes from: the drive's recorder where its profile has one, else synchronous TPDOs."""
+    return "recorder" if drive.profile.recorder is not None else "tpdo"
+
+
+def check_request(drive: Drive, request: MeasureRequest, bitrate: int | None = None) -> Multisine:
     """Everything that refuses a measurement, before anything is written; the excitation it will send."""
     if request.loop not in LOOPS:
         raise BadMeasurement(f"loop {request.loop!r}: use plant or closed")
+    source = source_of(drive)
     if not 0 < request.amplitude <= 100:
         raise BadMeasurement(f"amplitude {request.amplitude:g} %: give 0 < amplitude ≤ 100")
     limits = (request.base_speed_rad_s, request.position_window, request.current_limit_a or 1.0)
@@ -105,12 +129,23 @@ def check_request(drive: Drive, request: MeasureRequest) -> Multisine:
         raise BadMeasurement("base speed, position window and current limit must be > 0")
     if not 2 <= request.periods <= 32:
         raise BadMeasurement(f"{request.periods} periods: give 2 … 32")
-    if drive.profile.recorder is None:
+    if source == "tpdo":
+        _response_plan(drive, request, bitrate)
+    tilt = TILT[(request.loop, source)]
+    return design(request.from_hz, request.to_hz, request.points, SYNC_PERIOD_S, tilt, MONITOR_PATTERN)
+
+
+def _response_plan(drive: Drive, request: MeasureRequest, bitrate: int | None) -> ResponsePlan:
+    """The TPDO response's plan, or the refusal: a plant needs the current actual value, and the bus the SYNC
+    rate's frames."""
+    current = _present(drive, "current_actual")
+    if request.loop == "plant" and not current:
         raise NoRecorder(
-            f"node {drive.node}: the {drive.profile.device} has no recorder: the frequency response "
-            "records with the drive's recorder (synchronous TPDOs are not built yet)"
+            f"node {drive.node}: the {drive.profile.device} has no recorder and names no current actual value "
+            "(0x6078): the plant cannot be measured through TPDOs; measure the closed loop"
         )
-    return design(request.from_hz, request.to_hz, request.points, SYNC_PERIOD_S, TILT[request.loop], MONITOR_PATTERN)
+    excited = drive.variable(EXCITED[(request.loop, "tpdo")])
+    return plan_response(drive, excited, bitrate, SYNC_PERIOD_S, current)
 
 
 @dataclass
@@ -133,6 +168,7 @@ class Watch:
         stop: Callable[[str], None],
         controlled: Callable[[], bool],
         cancellation: Cancellation,
+        read: Callable[[], Mapping[str, object]] | None = None,
     ) -> None:
         self.drive, self.limits, self._stop, self.controlled, self.cancellation = (
             drive,
@@ -141,6 +177,8 @@ class Watch:
             controlled,
             cancellation,
         )
+        #: position and current now (by SDO unless the measurement's TPDOs bring them)
+        self.read = read or (lambda: read_values(drive, list(WATCHED)))
         self.reason: str | None = None
         self.halt = Cancellation()  # the recording in progress ends with the watch
         self._done = threading.Event()
@@ -169,7 +207,7 @@ class Watch:
             return "cancelled by its client"
         if not self.controlled():
             return "the axis's controller went away"
-        values = read_values(self.drive, ["position_actual", "current_actual"])
+        values = self.read()
         limits = self.limits
         travel = abs(int(str(values.get("position_actual", limits.start))) - limits.start)
         if travel > limits.window_units:
@@ -190,24 +228,54 @@ class Watch:
 
 @dataclass
 class Axis:
-    """What the measurement knows of the drive: units, rated current, torque constant."""
+    """What the measurement knows of the drive: units, the current the ‰ of 0x6078 refer to, torque constant."""
 
     units_per_rev: float
     rated_a: float
     torque_constant: float | None
+    rad_s_per_speed_unit: float
 
     @classmethod
     def of(cls, drive: Drive) -> Axis:
-        rated = float(drive.read("rated_current").physical) if drive.profile.has("rated_current") else 1.0
+        reference = drive.profile.current_reference
+        rated = float(drive.read(reference).physical) if _present(drive, reference) else 1.0
         name = drive.profile.procedures.torque_constant
-        kt = float(drive.read(name).physical) if name is not None and drive.profile.has(name) else None
-        return cls(units_per_revolution(drive), rated, kt or None)
+        kt = float(drive.read(name).physical) if name is not None and _present(drive, name) else None
+        if not kt and reference == "rated_current" and rated > 0 and _present(drive, "rated_torque"):
+            kt = float(drive.read("rated_torque").raw) / 1000.0 / rated  # 0x6076 mN·m of the rated current
+        units = units_per_revolution(drive)
+        return cls(units, rated, kt or None, drive.profile.speed_unit_rad_s or TWO_PI / units)
 
     def rad(self, user: float) -> float:
         return user / self.units_per_rev * TWO_PI
 
     def user(self, rad: float) -> float:
         return rad / TWO_PI * self.units_per_rev
+
+    def speed_rad(self, speed: float) -> float:
+        """rad/s of a speed in the drive's speed unit (0x606C, 0x60FF)."""
+        return speed * self.rad_s_per_speed_unit
+
+    def speed_user(self, rad_s: float) -> float:
+        return rad_s / self.rad_s_per_speed_unit
+
+
+def _present(drive: Drive, name: str) -> bool:
+    """The profile names the object and the drive's dictionary has it."""
+    if not drive.profile.has(name) or drive.dictionary is None:
+        return False
+    return drive.dictionary.get(*drive.profile.address(name)) is not None
+
+
+@dataclass
+class Collected:
+    """What a source collected: whole periods, and the estimate from them (computed only for a completed run)."""
+
+    source: str
+    periods: int = 0
+    points: Callable[[], list[estimate.Point]] = list
+    #: the plant is per N·m (the drive gives its torque constant), not per ampere: its J and B can be fitted
+    in_torque: bool = True
 
 
 def measure(
@@ -219,41 +287,110 @@ def measure(
     controlled: Callable[[], bool],
     quick_stop: Callable[[str], None],
     operational: bool,
+    bitrate: int | None = None,
 ) -> dict[str, Any]:
     """The measurement, start to end: the result dict without its identity fields (the service adds those)."""
-    signal = check_request(drive, request)
-    axis = Axis.of(drive)
-    gains = _gains(drive)
-    saved = read_values(drive, _touched(drive, request))
-    stream = ExcitationStream(drive, link, drive.variable(_excited(request)), SYNC_PERIOD_S)
+    signal = check_request(drive, request, bitrate)
+    source, axis, gains = source_of(drive), Axis.of(drive), _gains(drive)
+    saved = read_values(drive, _touched(drive, request, source))
+    stream = ExcitationStream(drive, link, drive.variable(EXCITED[(request.loop, source)]), SYNC_PERIOD_S)
+    response = ResponseStream(_response_plan(drive, request, bitrate), drive, link) if source == "tpdo" else None
     start = int(drive.read("position_actual").raw)
     limits = Limits(start, request.position_window * axis.units_per_rev, _current_permille(request, axis))
     watch: Watch | None = None
-    captures: list[Capture] = []
+    collected = Collected(source)
     try:
-        _prepare(drive, request, saved, axis)
-        watch = Watch(drive, limits, quick_stop, controlled, cancellation).start()
+        _prepare(drive, request, saved, axis, source)
+        values = _values(request, signal, axis, source, gains)
+        watch = Watch(drive, limits, quick_stop, controlled, cancellation, _watched(drive, response)).start()
         stream.open(operational)
-        stream.start(_values(request, signal, axis))
+        if response is not None:
+            response.open()
+        stream.start(values, response.answered if response is not None else None)
         report({"stage": "settling", "fraction": 0.05})
-        _pause(watch, SETTLE_S + signal.period_s)
-        captures = _record(drive, request, signal, watch, report)
+        collected = _collect(drive, request, signal, axis, watch, report, stream, response, values)
     finally:
-        left = _put_back(drive, stream, watch, saved)
+        left = _put_back(drive, stream, watch, saved, response)
     if cancellation.requested and (watch is None or watch.reason == "cancelled by its client"):
         raise Cancelled("frequency response cancelled by its client")
-    return _result(request, signal, axis, captures, gains, watch.reason if watch else None, left)
+    return _result(request, signal, collected, gains, watch.reason if watch else None, left)
 
 
-def _put_back(drive: Drive, stream: ExcitationStream, watch: Watch | None, saved: Mapping[str, object]) -> str | None:
-    """Stream, RPDO, node, axis and objects as they were — each step tried whatever the others did; what failed, or
-    None (a failure during an error is logged, so it does not hide the error)."""
-    failures: list[str] = []
+def _watched(drive: Drive, response: ResponseStream | None) -> Callable[[], Mapping[str, object]]:
+    """The watch's reading: the TPDO response's last sample once it runs (no SDO between the SYNCs), else SDO."""
+
+    def read() -> Mapping[str, object]:
+        latest = response.latest() if response is not None else None
+        return latest if latest is not None else read_values(drive, list(WATCHED))
+
+    return read
+
+
+def _collect(drive: Drive, request: MeasureRequest, signal: Multisine, axis: Axis, watch: Watch, report: Report,
+             stream: ExcitationStream, response: ResponseStream | None,
+             sent: Callable[[int], int]) -> Collected:  # fmt: skip
+    """Settle, then whole periods from the recorder or the TPDO response, until ``request.periods`` are there or the
+    watch stopped the axis."""
+    in_torque = axis.torque_constant is not None
+    if response is None:
+        _pause(watch, SETTLE_S + signal.period_s)
+        captures = _record(drive, request, signal, watch, report)
+        periods = sum(len(c.columns[0]) // _block(signal) for c in captures)
+        return Collected("recorder", periods, lambda: _estimate(request, signal, axis, captures), in_torque)
+    blocks = _follow(response, stream, signal, request, watch, report)
+    return Collected("tpdo", len(blocks), lambda: _tpdo_estimate(request, signal, axis, blocks, sent), in_torque)
+
+
+#: one period of the TPDO response: its first sample's number and the columns of its samples plus the next one
+Block = tuple[int, list[list[float]]]
+
+
+def _follow(response: ResponseStream, stream: ExcitationStream, signal: Multisine, request: MeasureRequest,
+            watch: Watch, report: Report) -> list[Block]:  # fmt: skip
+    """``request.periods`` whole periods of the response after settling, each one whose SYNCs stalled replaced by
+    the next; fewer when the watch stopped the axis."""
+    size = signal.samples
+    start = math.ceil((SETTLE_S + signal.period_s) / SYNC_PERIOD_S / size) * size
+    ideal = (start + request.periods * size) * SYNC_PERIOD_S
+    deadline = time.monotonic() + RESPONSE_STRETCH * ideal + RESPONSE_MARGIN_S
+    kept: list[int] = []
+    while len(kept) < request.periods and _answered(response, stream, start + size + 1, watch, deadline):
+        if stream.stalled(start - RELOCK_SYNCS, start + size, STALL_S) or response.stalled(
+            start - RELOCK_SYNCS, start + size, STALL_S
+        ):
+            log.info("node %s: frequency response: SYNCs stalled in period %d, taking another", response.plan.node,
+                     start // size)  # fmt: skip
+        else:
+            kept.append(start)
+            report({"stage": "recording", "fraction": round(0.1 + 0.8 * len(kept) / request.periods, 3)})
+        start += size
+    return [(first, response.columns(first, size + 1)) for first in kept]
+
+
+def _answered(response: ResponseStream, stream: ExcitationStream, count: int, watch: Watch, deadline: float) -> bool:
+    """Wait until the TPDOs answered ``count`` SYNCs (True) or the watch stopped the axis (False); a stopped SYNC
+    or a response that does not come by ``deadline`` fails the run."""
+    while response.answered() < count:
+        if watch.halt.requested:
+            return False
+        if stream.error is not None:
+            raise StreamFailed(f"node {response.plan.node}: the measurement's SYNC stopped: {stream.error}")
+        if time.monotonic() > deadline:
+            raise StreamFailed(f"node {response.plan.node}: the drive answered {response.answered()} of the "
+                               f"{count} SYNCs the response needs in time")  # fmt: skip
+        time.sleep(WATCH_S / 5)
+    return not watch.halt.requested
+
+
+def _put_back(drive: Drive, stream: ExcitationStream, watch: Watch | None, saved: Mapping[str, object],
+              response: ResponseStream | None) -> str | None:  # fmt: skip
+    """Stream, TPDOs, RPDO, node, axis and objects as they were — each step tried whatever the others did; what
+    failed, or None (a failure during an error is logged, so it does not hide the error)."""
     if watch is not None:
         watch.close()
-    left = stream.close()
-    if left is not None:
-        failures.append(left)
+    stream.stop()  # no SYNC while the response's TPDOs are written back
+    left = [response.close() if response is not None else None, stream.close()]
+    failures = [failure for failure in left if failure is not None]
     for what, step in (
         ("the axis was not stopped", lambda: _stop(drive, saved)),
         ("the objects were not put back", lambda: restore(drive, saved)),
@@ -267,11 +404,11 @@ def _put_back(drive: Drive, stream: ExcitationStream, watch: Watch | None, saved
     return "; ".join(failures) or None
 
 
-def _excited(request: MeasureRequest) -> str:
-    return "torque_offset" if request.loop == "plant" else "target_velocity"
+def _torque_excited(request: MeasureRequest, source: str) -> bool:
+    return EXCITED[(request.loop, source)] == "torque_offset"
 
 
-def _touched(drive: Drive, request: MeasureRequest) -> list[str]:
+def _touched(drive: Drive, request: MeasureRequest, source: str) -> list[str]:
     names = [
         "modes_of_operation",
         "target_velocity",
@@ -282,8 +419,9 @@ def _touched(drive: Drive, request: MeasureRequest) -> list[str]:
     ]
     if request.loop == "plant":
         names.append("current_monitor_filter")
+    if _torque_excited(request, source):
         names += _soft_gain_names(drive)
-    return [name for name in names if drive.profile.has(name)]
+    return [name for name in names if _present(drive, name)]
 
 
 def _soft_gain_names(drive: Drive) -> list[str]:
@@ -308,20 +446,21 @@ def _current_permille(request: MeasureRequest, axis: Axis) -> float | None:
     return 1000.0 * request.current_limit_a / axis.rated_a
 
 
-def _prepare(drive: Drive, request: MeasureRequest, saved: Mapping[str, object], axis: Axis) -> None:
-    """Profile velocity with ramps the loop never sees, the plant's loop softened, enabled at the base speed."""
+def _prepare(drive: Drive, request: MeasureRequest, saved: Mapping[str, object], axis: Axis, source: str) -> None:
+    """Profile velocity with ramps the loop never sees, the loop softened under a torque excitation, enabled at the
+    base speed."""
     writes: list[tuple[str, int]] = [("modes_of_operation", MODE_PV), ("torque_offset", 0), ("target_velocity", 0)]
     steep = _high(drive, "profile_acceleration")
     writes += [("profile_acceleration", steep), ("profile_deceleration", steep)]
-    base = round(axis.user(request.base_speed_rad_s))
-    top = axis.user(request.base_speed_rad_s * (2.0 + request.amplitude / 100.0))
-    if drive.profile.has("max_profile_velocity") and float(str(saved.get("max_profile_velocity", 0))) < top:
+    base = round(axis.speed_user(request.base_speed_rad_s))
+    top = axis.speed_user(request.base_speed_rad_s * 3.0)  # the base speed, and any swing (≤ base speed) twice over
+    if _present(drive, "max_profile_velocity") and float(str(saved.get("max_profile_velocity", 0))) < top:
         writes.append(("max_profile_velocity", round(top)))
-    if request.loop == "plant":
+    if _torque_excited(request, source):
         writes += _soft_writes(drive, saved)
-        if drive.profile.has("current_monitor_filter"):
-            writes.append(("current_monitor_filter", _high(drive, "current_monitor_filter")))
-    present = [(drive.variable(name), value) for name, value in writes if drive.profile.has(name)]
+    if request.loop == "plant" and _present(drive, "current_monitor_filter"):
+        writes.append(("current_monitor_filter", _high(drive, "current_monitor_filter")))
+    present = [(drive.variable(name), value) for name, value in writes if _present(drive, name)]
     drive.submit_write_all(present).future.result()
     set_state(drive, State.OPERATION_ENABLED)
     drive.write("target_velocity", base)
@@ -344,14 +483,28 @@ def _high(drive: Drive, name: str) -> int:
     return (1 << (bits - 1 if variable.data_type.is_signed else bits)) - 1
 
 
-def _values(request: MeasureRequest, signal: Multisine, axis: Axis) -> Callable[[int], int]:
+def _values(request: MeasureRequest, signal: Multisine, axis: Axis, source: str,
+            gains: Mapping[str, Any] | None) -> Callable[[int], int]:  # fmt: skip
     """Value k of the stream in the excited object's raw unit."""
-    if request.loop == "plant":
+    if _torque_excited(request, source):
         peak = 10.0 * request.amplitude  # ‰ of the rated current
         return lambda k: round(peak * signal.value(k))
-    base = axis.user(request.base_speed_rad_s)
-    swing = base * request.amplitude / 100.0
+    base = axis.speed_user(request.base_speed_rad_s)
+    swing = axis.speed_user(_swing(request, axis, gains))
     return lambda k: round(base + swing * signal.value(k))
+
+
+def _swing(request: MeasureRequest, axis: Axis, gains: Mapping[str, Any] | None) -> float:
+    """The velocity excitation's peak, rad/s: for the closed loop ``amplitude`` % of the base speed; for the plant the
+    swing whose loop error asks ``amplitude`` % of the rated current of the proportional gain (above the loop's
+    bandwidth the current is KPv × the swing: a stiff loop on a heavy axis saturates its current at a swing a
+    light one hardly feels), at most ``MAX_SWING`` of the base speed; without a known KPv, that share of it."""
+    base = request.base_speed_rad_s
+    if request.loop == "closed":
+        return base * request.amplitude / 100.0
+    kp = float((gains or {}).get("kp_a_per_rad_s") or 0.0)
+    current = request.amplitude / 100.0 * axis.rated_a
+    return min(current / kp, MAX_SWING * base) if kp > 0 else MAX_SWING * base * request.amplitude / 100.0
 
 
 def _pause(watch: Watch, seconds: float) -> bool:
@@ -451,8 +604,7 @@ def _stop(drive: Drive, saved: Mapping[str, object]) -> None:
 def _result(
     request: MeasureRequest,
     signal: Multisine,
-    axis: Axis,
-    captures: list[Capture],
+    collected: Collected,
     gains: dict[str, Any] | None,
     aborted: str | None,
     left: str | None,
@@ -460,7 +612,8 @@ def _result(
     """The result dict (contract of issue #16); an aborted measurement has no points."""
     if left is not None:
         aborted = f"{aborted}; {left}" if aborted else left
-    points: list[estimate.Point] = [] if aborted else _estimate(request, signal, axis, captures)
+    points: list[estimate.Point] = [] if aborted else collected.points()
+    source = collected.source
     shown = estimate.as_points(points)
     return {
         "kind": "frequency_response",
@@ -472,13 +625,16 @@ def _result(
             "points": len(signal.harmonics),
             "amplitude_pct": request.amplitude,
             "base_speed_rad_s": request.base_speed_rad_s,
-            "periods": sum(len(c.columns[0]) // _block(signal) for c in captures),
-            "sample_period_us": RECORD_PERIOD_US,
-            "source": "recorder",
+            "periods": collected.periods,
+            "sample_period_us": RECORD_PERIOD_US if source == "recorder" else round(SYNC_PERIOD_S * 1e6, 3),
+            "source": source,
+            # what the magnitude is per: the plant's torque (N·m), or its current (A) on a drive without a torque
+            # constant (the CD1-k); the closed loop's demanded velocity
+            "input": "velocity" if request.loop == "closed" else "torque" if collected.in_torque else "current",
         },
         "points": shown,
         "markers": markers.markers_of(request.loop, shown),
-        "plant_fit": estimate.rigid_fit(points) if request.loop == "plant" and points else None,
+        "plant_fit": estimate.rigid_fit(points) if request.loop == "plant" and points and collected.in_torque else None,
         "gains": gains,
         "aborted": aborted,
     }
@@ -502,7 +658,7 @@ def _estimate(request: MeasureRequest, signal: Multisine, axis: Axis, captures: 
             reference += estimate.block_lines(columns[2], harmonics, block)
         else:
             positions = [axis.rad(value) for value in columns[1]]
-            inputs += estimate.block_lines([axis.rad(value) for value in columns[0]], harmonics, block)
+            inputs += estimate.block_lines([axis.speed_rad(value) for value in columns[0]], harmonics, block)
         outputs += estimate.speed_lines(estimate.position_lines(positions, harmonics, block), frequencies)
     if request.loop == "plant":
         return estimate.by_reference(reference, inputs, outputs, frequencies)
@@ -511,3 +667,27 @@ def _estimate(request: MeasureRequest, signal: Multisine, axis: Axis, captures: 
 
 def _advanced(row: estimate.Lines, frequencies: list[float], seconds: float) -> estimate.Lines:
     return [value * cmath.exp(2j * math.pi * f * seconds) for value, f in zip(row, frequencies, strict=True)]
+
+
+def _tpdo_estimate(request: MeasureRequest, signal: Multisine, axis: Axis, blocks: list[Block],
+                   sent: Callable[[int], int]) -> list[estimate.Point]:  # fmt: skip
+    """From the TPDO response (position, target velocity read back, current): the closed loop from the staircase
+    of targets the drive held (its latency found from the read-back) to the shaft speed (H1); the plant from the
+    current, each value at the instant it was measured, to the shaft speed, through the targets (the reference)."""
+    size, harmonics, frequencies = signal.samples, list(signal.harmonics), signal.frequencies_hz
+    torque = (axis.torque_constant or 1.0) * axis.rated_a / 1000.0
+    targets, currents, outputs = [], [], []
+    for first, columns in blocks:
+        positions = [axis.rad(value) for value in columns[0]]
+        outputs += estimate.speed_lines(estimate.position_lines(positions, harmonics, size), frequencies)
+        lines = estimate.block_lines([axis.speed_rad(value) for value in columns[1]], harmonics, size)
+        delay = tpdo_source.latency(columns[1][:size], sent, first)  # also: were the values applied at their SYNCs?
+        if request.loop == "closed":
+            targets += tpdo_source.held_input(lines, harmonics, size, delay)
+        else:
+            targets += lines
+            currents += estimate.monitored_lines([torque * value for value in columns[2]], harmonics, size,
+                                                 SYNC_PERIODS, CURRENT_HOLD)  # fmt: skip
+    if request.loop == "closed":
+        return estimate.h1(targets, outputs, frequencies)
+    return estimate.by_reference(targets, currents, outputs, frequencies)

@@ -1,8 +1,9 @@
 """The frequency-response service: one implementation behind the REST route, its job and the CLI.
 
-``check`` refuses before anything is written (bad request 422, no recorder 422, no armed controller 409, unknown
-project or axis 404); ``run`` measures (``measure.py``), adds who, what and when, and saves the result under the
-axis when the request names project and axis (``store.py``).
+``check`` refuses before anything is written (bad request 422, a drive whose response cannot come back — a plant
+through TPDOs without a current actual value, a bus too slow for the SYNC rate's frames — 422, no armed controller
+409, unknown project or axis 404); ``run`` measures (``measure.py``), adds who, what and when, and saves the result
+under the axis when the request names project and axis (``store.py``).
 """
 
 from __future__ import annotations
@@ -37,21 +38,24 @@ class FrequencyService:
     def __init__(self, projects: ProjectStore | None = None) -> None:
         self.projects = projects
 
-    def check(self, motion: MotionGuard, axis: Axis, drive: Drive, request: FrequencyRequest) -> None:
-        check_request(drive, request.measure)
+    def check(
+        self, motion: MotionGuard, axis: Axis, drive: Drive, request: FrequencyRequest, bitrate: int | None = None
+    ) -> None:
+        check_request(drive, request.measure, bitrate)
         motion.require_controller(current_actor(), axis, "the frequency response turns the motor")
         self._check_target(request)
 
     def start(
         self, jobs: JobRegistry, motion: MotionGuard, connection: BusConnection, drive: Drive, request: FrequencyRequest
     ) -> Job:
-        self.check(motion, (connection.id, drive.node), drive, request)
+        self.check(motion, (connection.id, drive.node), drive, request, connection.spec.bitrate)
 
         def work(progress: Callable[[dict[str, object]], None], cancellation: Cancellation) -> object:
             report = _on_axis(progress, connection.id, drive.node)
             return self.run(motion, connection, drive, request, report, cancellation)
 
-        return jobs.start(OPERATION, work)
+        # the measurement borrows the node's last RPDO and its recorder or TPDOs, and sends the bus's SYNC
+        return connection.claims.start((drive.node,), lambda: jobs.start(OPERATION, work), sync=True)
 
     def run(
         self,
@@ -64,7 +68,7 @@ class FrequencyService:
     ) -> dict[str, Any]:
         """The whole measurement (what the job runs; the CLI calls it directly)."""
         axis = (connection.id, drive.node)
-        self.check(motion, axis, drive, request)
+        self.check(motion, axis, drive, request, connection.spec.bitrate)
         actor = current_actor()
         when = datetime.now(UTC).isoformat(timespec="seconds").replace("+00:00", "Z")
         outcome = measure(
@@ -76,6 +80,7 @@ class FrequencyService:
             _controlled(motion, axis, actor.client),
             lambda why: motion.quick_stop(axis, drive, f"frequency response: {why}", running=True),
             connection.nmt_state(drive.node) == "OPERATIONAL",
+            connection.spec.bitrate,
         )
         result = {
             "kind": outcome.pop("kind"),

@@ -2,8 +2,10 @@
 
 One place converts, from the device profile's ``SpeedLoopDescription`` (docs/control-loops.md §1–2), for the
 what-if model in the browser (docs/what-if.md), the identification's tuning and the frequency response's record of
-the loop it measured.  A drive without gain objects (the encoTRive: factory-set loops) has no speed loop to read or
-write: both refuse with :class:`NoSpeedLoop`.
+the loop it measured.  A drive whose gains the drive derives itself from an inertia setting (the encoTRive's Θi,
+docs/identification.md § Tuning) reads as those derived gains and takes only ``inertia_setting_kgm2``.  A drive
+without any description (a generic CiA 402 drive) has no speed loop to read or write: both refuse with
+:class:`NoSpeedLoop`.
 
 Writes are validated completely before anything is sent (unknown key, negative or non-finite value, a raw value out
 of its object's range, a speed filter the drive cannot select), and go through the drive's gate in one batch.  The
@@ -19,7 +21,7 @@ from collections.abc import Mapping
 from typing import Any
 
 from servostudio.drive.access import Drive
-from servostudio.drive.profiles.speed_loop import SpeedLoopDescription
+from servostudio.drive.profiles.speed_loop import InertiaSetting, SpeedLoopDescription
 from servostudio.drive.sdo import settle
 from servostudio.errors import InvalidInput, NotFound
 from servostudio.services.procedures.run import read_values
@@ -28,6 +30,7 @@ from servostudio.services.procedures.run import read_values
 MAX_MULTIPLIER_SHIFT = 7
 FILTER_KEYS = ("current_filter_1_hz", "current_filter_2_hz", "current_filter_3_hz")
 SPEED_FILTER_KEY = "speed_filter_s"
+INERTIA_KEY = "inertia_setting_kgm2"
 
 
 class NoSpeedLoop(NotFound):
@@ -42,8 +45,8 @@ def description(drive: Drive) -> SpeedLoopDescription:
     found = drive.profile.speed_loop
     if found is None:
         raise NoSpeedLoop(
-            f"node {drive.node}: the {drive.profile.device} has no speed-loop gain objects (its loops are set in "
-            "the factory): nothing to read, model or write"
+            f"node {drive.node}: the {drive.profile.device} has no speed-loop gain objects the tool knows: "
+            "nothing to read, model or write"
         )
     return found
 
@@ -61,7 +64,9 @@ def read_speed_loop(drive: Drive) -> dict[str, Any]:
     }
     for key, scale in loop.gains.items():
         result[key] = float(raw.get(scale.object, 0)) * scale.unit * (multiplier if scale.scaled else 1.0)
-    result.setdefault("ki_leak_hz", 0.0)
+    result.update(_derived(loop.inertia_setting, raw))
+    for key in ("kp_a_per_rad_s", "ki_a_per_rad", "ki_leak_hz", "kc_a_per_rad_s", "kd_a_per_rad_s2"):
+        result.setdefault(key, 0.0)
     result["current_filters_hz"] = [float(raw.get(name, 0)) for name in loop.current_filters if name in raw]
     result[SPEED_FILTER_KEY] = _speed_filter_s(loop, raw)
     result["speed_filter_choices_s"] = sorted(loop.speed_filter_s.values()) if loop.speed_filter is not None else []
@@ -77,6 +82,8 @@ def writable(drive: Drive) -> list[str]:
     keys += [key for key, name in zip(FILTER_KEYS, loop.current_filters, strict=False) if drive.profile.has(name)]
     if loop.speed_filter is not None and drive.profile.has(loop.speed_filter):
         keys.append(SPEED_FILTER_KEY)
+    if loop.inertia_setting is not None and drive.profile.has(loop.inertia_setting.object):
+        keys.append(INERTIA_KEY)
     return keys
 
 
@@ -88,6 +95,7 @@ def raw_writes(drive: Drive, physical: Mapping[str, float]) -> list[tuple[str, i
     raw = _read_raw(drive, loop)
     writes = _gain_writes(loop, raw, physical)
     writes += _filter_writes(loop, physical)
+    writes += _inertia_writes(loop.inertia_setting, physical)
     for name, value in writes:
         drive.prepare_write(name, value)  # the dictionary's type and range, before anything is sent
     return writes
@@ -105,6 +113,9 @@ def write_speed_loop(drive: Drive, physical: Mapping[str, float]) -> dict[str, A
 def _read_raw(drive: Drive, loop: SpeedLoopDescription) -> dict[str, int]:
     names = [scale.object for scale in loop.gains.values()] + list(loop.current_filters)
     names += [name for name in (loop.multiplier, loop.speed_filter, loop.torque_constant) if name is not None]
+    if loop.inertia_setting is not None:
+        setting = loop.inertia_setting
+        names += [setting.object, setting.rated_torque, setting.rated_current]
     return {name: int(value) for name, value in read_values(drive, names).items() if isinstance(value, int)}
 
 
@@ -115,9 +126,38 @@ def _multiplier(loop: SpeedLoopDescription, raw: Mapping[str, int]) -> float:
 
 
 def _torque_constant(loop: SpeedLoopDescription, raw: Mapping[str, int]) -> float | None:
+    if loop.inertia_setting is not None:
+        return _rated_constant(loop.inertia_setting, raw)
     if loop.torque_constant is None or loop.torque_constant not in raw:
         return None
     return raw[loop.torque_constant] * loop.torque_constant_unit
+
+
+def _rated_constant(setting: InertiaSetting, raw: Mapping[str, int]) -> float | None:
+    """Kt = rated torque / rated current, N·m/A (None where either is missing or 0)."""
+    torque = raw.get(setting.rated_torque, 0) * setting.rated_torque_unit
+    current = raw.get(setting.rated_current, 0) * setting.rated_current_unit
+    return torque / current if torque > 0 and current > 0 else None
+
+
+def _derived(setting: InertiaSetting | None, raw: Mapping[str, int]) -> dict[str, float]:
+    """The inertia setting and the gains the drive derives from it: KPv = Θi·ωd/Kt, KIv = KPv·ωd/8, KAv = Θi/Kt."""
+    if setting is None or setting.object not in raw:
+        return {}
+    inertia = raw[setting.object] * setting.unit_kgm2
+    constant = _rated_constant(setting, raw)
+    if constant is None:
+        return {INERTIA_KEY: inertia}
+    kp = inertia * setting.design_crossover / constant
+    zero = setting.design_crossover / setting.integral_divisor
+    return {INERTIA_KEY: inertia, "kp_a_per_rad_s": kp, "ki_a_per_rad": kp * zero,
+            "ka_a_per_rad_s2": inertia / constant}  # fmt: skip
+
+
+def _inertia_writes(setting: InertiaSetting | None, physical: Mapping[str, float]) -> list[tuple[str, int]]:
+    if setting is None or INERTIA_KEY not in physical:
+        return []
+    return [(setting.object, _count_of(physical[INERTIA_KEY] / setting.unit_kgm2, INERTIA_KEY, 0xFFFFFFFF))]
 
 
 def _speed_filter_s(loop: SpeedLoopDescription, raw: Mapping[str, int]) -> float:
@@ -172,8 +212,12 @@ def _choose_multiplier(loop: SpeedLoopDescription, values: Mapping[str, float]) 
 
 
 def _count(value: float, key: str) -> int:
-    if not value < 0xFFFF + 0.5:
-        raise BadSpeedLoop(f"{key}: {value:.6g} counts is out of range (0..65535)")
+    return _count_of(value, key, 0xFFFF)
+
+
+def _count_of(value: float, key: str, high: int) -> int:
+    if not value < high + 0.5:
+        raise BadSpeedLoop(f"{key}: {value:.6g} counts is out of range (0..{high})")
     return round(value)
 
 

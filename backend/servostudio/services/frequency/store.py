@@ -106,14 +106,16 @@ def _comments(result: Mapping[str, Any]) -> list[tuple[str, str]]:
         ("node", str(result.get("node", ""))),
         ("time", str(result.get("time", ""))),
         ("excitation", ", ".join(f"{key}={value}" for key, value in excitation.items())),
-        ("magnitude", _magnitude_meaning(str(result.get("loop", "")))),
+        ("magnitude", _magnitude_meaning(result)),
         ("aborted", str(result.get("aborted") or "")),
     ]
 
 
-def _magnitude_meaning(loop: str) -> str:
-    if loop == "plant":
-        return "dB of (velocity in rad/s) / (torque in N*m)"
+def _magnitude_meaning(result: Mapping[str, Any]) -> str:
+    """A plant per N·m, or per A where the drive gave no torque constant (the excitation's ``input``)."""
+    if result.get("loop") == "plant":
+        per_ampere = (result.get("excitation") or {}).get("input") == "current"
+        return f"dB of (velocity in rad/s) / ({'current in A' if per_ampere else 'torque in N*m'})"
     return "dB of actual / demanded velocity"
 
 

@@ -12,6 +12,7 @@ afterwards when it was not operational before.  Just before SYNC k the producer'
 
 from __future__ import annotations
 
+import itertools
 import struct
 from collections.abc import Callable
 
@@ -49,13 +50,15 @@ class ExcitationStream:
             send_nmt(self.link, NmtCommand.START, self.drive.node)
             self.started_node = True
 
-    def start(self, value_of: Callable[[int], int]) -> None:
-        """SYNC every period from now on, value k sent just before SYNC k."""
+    def start(self, value_of: Callable[[int], int], answered: Callable[[], int] | None = None) -> None:
+        """SYNC every period from now on, value k sent just before SYNC k; with ``answered`` (the SYNCs the response's
+        TPDOs have answered) the same producer paces itself by the answers, as a TPDO capture's does."""
         assert self.saved is not None
         identifier, pack = self.saved.identifier, self.layout.pack
         self.producer = SyncProducer(
             self.link,
             self.period_s,
+            answered,
             before=lambda k: self.link.send(identifier, pack(value_of(k))),
             minimum_s=self.period_s,
         )
@@ -64,6 +67,12 @@ class ExcitationStream:
     @property
     def error(self) -> str | None:
         return self.producer.error if self.producer is not None else None
+
+    def stalled(self, first: int, last: int, longest_s: float) -> bool:
+        """Did any two of SYNCs ``first`` … ``last`` leave more than ``longest_s`` apart (a drive locked to the SYNC
+        loses it; the simulator runs free again)?"""
+        sent = self.producer.sent[max(first, 0) : last + 1] if self.producer is not None else []
+        return any(later - earlier > longest_s for earlier, later in itertools.pairwise(sent))
 
     def stop(self) -> None:
         if self.producer is not None:

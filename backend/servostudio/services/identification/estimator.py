@@ -82,9 +82,15 @@ class Plant:
 def estimate(record: Record) -> Plant:
     """The plant of the torque shift that fits best (smallest residual): the drive measures its current through a
     filter and updates it on its own period, so the torque samples may lag the motion by a sample or two."""
+    return _physical(best_fit(record), record)
+
+
+def best_fit(record: Record) -> Plant:
+    """The fit of the best torque shift, physical or not (a first pass wants only its inertia: the ramps give it
+    well even when the holds are too rough for the friction)."""
     fits = [_fit(shifted(record, shift)) for shift in SHIFTS]
     best = min(range(len(fits)), key=lambda n: fits[n].residual)
-    return _physical(replace(fits[best], torque_shift_samples=SHIFTS[best]), record)
+    return replace(fits[best], torque_shift_samples=SHIFTS[best])
 
 
 def _physical(plant: Plant, record: Record) -> Plant:

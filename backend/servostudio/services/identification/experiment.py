@@ -17,6 +17,7 @@ drive is disabled and every object the run changed is written back whatever happ
 
 from __future__ import annotations
 
+import contextvars
 import threading
 import time
 from collections.abc import Callable
@@ -212,7 +213,9 @@ def _recorded(drive: Drive, options: ExperimentOptions, scale: Scales, report: C
             outcome["error"] = error
         armed.set()
 
-    thread = threading.Thread(target=record, name=f"identification {drive.node}", daemon=True)
+    # the capture acts for whoever runs the experiment (its NMT start is judged by the motion guard as theirs)
+    context = contextvars.copy_context()
+    thread = threading.Thread(target=context.run, args=(record,), name=f"identification {drive.node}", daemon=True)
     thread.start()
     armed.wait(definition.timeout_s)
     try:

@@ -25,9 +25,9 @@ from concurrent.futures import CancelledError, Future
 from typing import TYPE_CHECKING, TypeGuard
 
 from servostudio.drive.access import Drive, DriveAccessError, PlannedWrite, WriteOutcomes
-from servostudio.drive.cia402 import Command, State
-from servostudio.drive.control import read_state, set_state
-from servostudio.drive.nmt import NmtCommand
+from servostudio.drive.cia402 import State
+from servostudio.drive.control import quick_stop_word, read_state, set_state
+from servostudio.drive.nmt import NmtCommand, NmtHeard
 from servostudio.errors import Forbidden, RefusedForSafety, ServoStudioError
 from servostudio.od.model import Variable
 from servostudio.services.audit import SERVER, Actor, AuditLog, acting_as, axis_name, current_actor, printable
@@ -45,8 +45,6 @@ Publish = Callable[[dict[str, object]], None]
 OLD_VALUES_UP_TO = 16
 #: a node an NMT command addresses: its ID, its drive (to read its state) and its NMT state as last announced
 NmtTarget = tuple[int, Drive, "str | None"]
-#: hears an NMT command's outcome: None once the frame is on the bus, else the error that kept it off
-NmtHeard = Callable[[BaseException | None], None]
 #: the user levels that may take an axis over from its controller (``services.users.levels.Level``)
 TAKE_OVER_LEVELS = frozenset({"expert", "administrator"})
 
@@ -70,10 +68,13 @@ class BusGate:
 
 
 class MotionGuard:
-    def __init__(self, publish: Publish = _publish_nowhere, audit: AuditLog | None = None) -> None:
+    def __init__(self, publish: Publish = _publish_nowhere, audit: AuditLog | None = None,
+                 old_values_up_to: int | None = OLD_VALUES_UP_TO) -> None:  # fmt: skip
         self.controllers = Controllers()
         self.publish = publish
         self.audit = audit if audit is not None else AuditLog(None)
+        #: the largest write batch whose old values are read first for the log (None: every batch)
+        self.old_values_up_to = old_values_up_to
         self._objects: dict[str, MotionObjects] = {}
         #: the quick test's jogs, moves and homing, each started through this guard (``jog``)
         self.motions = Motions(self)
@@ -92,7 +93,7 @@ class MotionGuard:
         except RefusedForSafety as refusal:
             self.audit.record(_write_entries(actor, axis, writes, [None] * len(writes), [refusal] * len(writes)))
             raise
-        old_values = _read_before(drive, writes)
+        old_values = _read_before(drive, writes, self.old_values_up_to)
         return lambda outcomes: self._written(actor, axis, writes, verdict, old_values(), outcomes)
 
     def check(self, actor: Actor, axis: Axis, drive: Drive, writes: Sequence[PlannedWrite]) -> Verdict:
@@ -262,7 +263,7 @@ class MotionGuard:
                 return
             entry = {"action": "quick_stop", "axis": axis_name(*axis), "detail": why}
             try:
-                drive.write("controlword", int(Command.QUICK_STOP))  # at once: one write, no read of it first
+                drive.write("controlword", quick_stop_word(drive))  # at once: one write, no read of it first
                 set_state(drive, State.QUICK_STOP_ACTIVE)  # and checked: the drive took it (or went further down)
             except ServoStudioError as error:
                 self.audit.record([entry | {"result": "failed", "detail": f"{why}: {error}"}])
@@ -279,13 +280,13 @@ def _current_state(drive: Drive) -> State | None:
         return None
 
 
-def _read_before(drive: Drive, writes: Sequence[PlannedWrite]) -> Callable[[], list[object]]:
+def _read_before(drive: Drive, writes: Sequence[PlannedWrite], up_to: int | None) -> Callable[[], list[object]]:
     """Queue reads of the written objects ahead of the writes, so the log can say old → new; returns what gives the
     old values once the writes are done (None where unknown).  One write reads in the interactive lane, a batch in
-    the bulk lane, each ahead of its writes in the node's queue; a batch larger than ``OLD_VALUES_UP_TO`` (a
-    restore) is not read first: that would cost it half its time again (docs/security.md, Audit log)."""
+    the bulk lane, each ahead of its writes in the node's queue; a batch larger than ``up_to`` (a restore, by
+    default) is not read first: that would cost it half its time again (docs/security.md, Audit log)."""
     readable = [(position, write.variable) for position, write in enumerate(writes) if _readable(write.variable)]
-    if not readable or len(writes) > OLD_VALUES_UP_TO:
+    if not readable or (up_to is not None and len(writes) > up_to):
         return lambda: [None] * len(writes)
     variables = [variable for _, variable in readable]
     future = drive.submit_read_all(variables).future if len(writes) > 1 else _as_list(drive.submit_read(variables[0]))

@@ -1,4 +1,5 @@
-"""The quick test's motions (manual §1.8.19): a profile-velocity jog, profile-position moves and homing.
+"""The quick test's motions (manual §1.8.19): a profile-velocity jog (or the drive's own jog bits, the TTA-PRO's),
+profile-position moves and homing.
 
 One implementation for the browser, the REST API and the CLI.  A motion is started by the axis's armed controller
 only (``MotionGuard.require_controller`` before anything is written, and the guard judges every write again), within
@@ -114,10 +115,10 @@ class Motions:
             raise InvalidInput("a jog needs 'seconds' or 'hold': it must end by itself or when released")
         if seconds is not None:
             limits.check_seconds(axis, seconds)
-        writes = [("modes_of_operation", PROFILE_VELOCITY), ("target_velocity", rpm_to_speed(drive, velocity))]
+        writes, trigger = _jog_writes(drive, velocity)
         request = {"velocity": velocity, "seconds": seconds}
         run = self._begin(actor, axis, drive, "jog", hold, request)
-        return self._launch(run, writes, None, self._jog_finished(run, seconds))
+        return self._launch(run, writes, trigger, self._jog_finished(run, seconds))
 
     def move(
         self,
@@ -234,6 +235,9 @@ class Motions:
             if run.hold or trigger is not None:
                 self._stop_quietly(run, f"{run.kind} could not start: {error}")
             raise
+        if run.state != "running":  # ended while it started (its hold expired, a stop): it must not run on
+            self._stop_quietly(run, f"{run.kind} {run.id} ended while it started: {run.reason}")
+            return run.as_dict()
         self.guard.publish({"type": "motion", **run.as_dict()})
         context = contextvars.copy_context()  # the controller's: what the motion writes later, it writes
         follower = threading.Thread(target=context.run, args=(self._follow, run, finished), daemon=True)
@@ -270,7 +274,7 @@ class Motions:
         def over(statusword: int) -> tuple[str, str | None] | None:
             if seconds is None or time.monotonic() - run.since < seconds:
                 return None
-            run.drive.write("target_velocity", 0)
+            _end_jog(run.drive)
             return "done", None
 
         return over
@@ -309,6 +313,37 @@ class Motions:
             self.guard.quick_stop(run.axis, run.drive, why, running)
         except ServoStudioError as error:
             run.reason = f"{why}; the quick stop failed: {error}"
+
+
+def _jog_writes(drive: Drive, velocity: float) -> tuple[list[tuple[str, int]], Callable[[Drive], None] | None]:
+    """What starts a jog at ``velocity`` rpm. CiA 402: profile velocity at that target velocity. A drive with jog
+    bits (``DeviceProfile.jog_bits``, the TTA-PRO's CW8 / CW9): its jog speed in rpm, then, once enabled, the bit of
+    the direction, which the drive jogs on while it stays set (0 rpm: no bit, the axis stays at standstill)."""
+    bits = drive.profile.jog_bits
+    if bits is None:
+        return [("modes_of_operation", PROFILE_VELOCITY), ("target_velocity", rpm_to_speed(drive, velocity))], None
+    direction = 0 if velocity == 0 else bits[0] if velocity > 0 else bits[1]
+    speed = max(1, round(abs(velocity)))
+    return [("jog_speed", speed)], lambda enabled: _start_jog(enabled, direction)
+
+
+def _start_jog(drive: Drive, direction: int) -> None:
+    """Set the direction's jog bit (the drive jogs while it stays set)."""
+    drive.write("controlword", _jog_word(drive) | direction)
+
+
+def _jog_word(drive: Drive) -> int:
+    """The control word going out without the jog bits."""
+    plus, minus = drive.profile.jog_bits or (0, 0)
+    return int(drive.read("controlword").raw) & ~(plus | minus)
+
+
+def _end_jog(drive: Drive) -> None:
+    """A timed jog is over: target velocity 0, or the jog bits cleared (the drive ramps down, stays enabled)."""
+    if drive.profile.jog_bits is None:
+        drive.write("target_velocity", 0)
+    else:
+        drive.write("controlword", _jog_word(drive))
 
 
 def _set_point(bits: int) -> Callable[[Drive], None]:

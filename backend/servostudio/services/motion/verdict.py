@@ -104,9 +104,16 @@ def _controlword(state: State | None, raw: object) -> tuple[Verdict, State | Non
     shown = f"control word 0x{raw:04X} takes the axis from {state.value} to {after.value}"
     if after is State.OPERATION_ENABLED:
         return Verdict(Motion.MOVES, shown, enables=state is not State.OPERATION_ENABLED), after
-    if _POWER.get(after, 0) < _POWER.get(state, 0):
+    if _POWER.get(after, 0) < _POWER.get(state, 0) or _stop_command(raw):
         return Verdict(Motion.STOPS, shown, stops=state is State.OPERATION_ENABLED), after
     return Verdict(Motion.PREPARES, shown), after
+
+
+def _stop_command(raw: int) -> bool:
+    """Disable voltage (bit 1 clear) or quick stop (bit 2 clear) without a fault reset: from every state it leads
+    down the ladder or nowhere, so it is a stop anyone may make — a hold watchdog's quick stop of an axis that is
+    already disabled too (CiA 402 Table 27)."""
+    return not raw & 0x80 and (not raw & 0x02 or not raw & 0x04)
 
 
 #: how far up the ladder a state is: a transition to a lower one powers the axis down, a stop anyone may make

@@ -5,13 +5,16 @@ value it changed put back.
 
 The steps are small enough that the current stays below its limit (a saturated loop says nothing about its
 bandwidth): Δω = I_step·Kt / (J·ω) of the requested bandwidth, from the identified inertia and the torque constant,
-I_step the rated current but at most half the max current. They start from a small base speed, not from rest
-(Coulomb friction, see BASE_SHARE), and alternate in direction. A drive without a recorder gets no verification
-(``skipped`` says why).
+I_step the rated current but at most half the max current (on a drive that gives its rated torque 6076h rather
+than a torque constant: that torque, at most half the max current's). They start from a small base speed, not from
+rest (Coulomb friction, see BASE_SHARE), and alternate in direction. A drive's own auto-tuning without a recorder
+gets no verification (``skipped`` says why); the tool's tuning (``verify_steps``) records such a drive by
+synchronous TPDOs at 1 ms instead (the encoTRive).
 """
 
 from __future__ import annotations
 
+import statistics
 import time
 from collections.abc import Callable, Mapping, Sequence
 from typing import TYPE_CHECKING, Any
@@ -25,6 +28,7 @@ from servostudio.services.procedures.run import disable, read_values, restore
 from servostudio.services.procedures.stepmetrics import Recording, mean_bandwidth, step_metrics, window
 from servostudio.services.procedures.units import TWO_PI, speed_rad_s, units_per_revolution, user_speed
 from servostudio.services.scope import Capture, CaptureDefinition, Trigger
+from servostudio.services.scope.plan import object_key
 
 if TYPE_CHECKING:
     from servostudio.services.procedures.run import ProcedureRun
@@ -35,6 +39,9 @@ MODE_PP, MODE_PV = 1, 3
 POSITION_MODES = (1, 7, 8)
 PERIOD_US = 500.0
 SAMPLES = 800  # 0.4 s: a slow loop (anti-resonance filter) settles within it
+#: without a recorder: synchronous TPDOs at the SYNC producer's fastest period, over the same 0.4 s
+STREAM_PERIOD_US = 1000.0
+STREAM_SAMPLES = 400
 PRE_TRIGGER_PCT = 5.0
 #: the ramps of a step: a fraction of a second to full speed is a step for a loop of 50 Hz and more
 STEP_RAMP_REV_S2 = 20000.0
@@ -56,6 +63,9 @@ RPM = 60.0 / TWO_PI
 #: recorded speed steps, alternating in direction (the travel nets out; the mean of their frequency responses
 #: averages the speed measurement's quantisation noise out of the bandwidth)
 SPEED_STEPS = 2
+#: ... and by TPDOs more of them: a sample of 0x606C is the drive's latest up to one SYNC period old, a jitter each
+#: step has its own (measured on the simulated encoTRive: one step 57-80 Hz of a 68 Hz loop)
+STREAM_SPEED_STEPS = 6
 
 
 def verify(run: ProcedureRun, result: dict[str, object], options: Mapping[str, Any]) -> dict[str, object] | None:
@@ -68,6 +78,13 @@ def verify(run: ProcedureRun, result: dict[str, object], options: Mapping[str, A
     drive = run.drive
     if drive.profile.recorder is None:
         return {"speed_step": None, "position_step": None, "skipped": f"the {drive.profile.device} has no recorder"}
+    return verify_steps(run, result, options)
+
+
+def verify_steps(run: ProcedureRun, result: dict[str, object], options: Mapping[str, Any]) -> dict[str, object]:
+    """The speed steps, and a position step after a tuning in a position mode, recorded by the drive's recorder or
+    (without one) by synchronous TPDOs; the axis left disabled with every value the steps changed put back."""
+    drive = run.drive
     run.progress("verifying", "done", "verification: speed step", None)
     saved = read_values(drive, list(drive.profile.procedures.verification_objects))
     start = int(drive.read("position_actual").raw)
@@ -85,14 +102,27 @@ def _step_size(drive: Drive, result: dict[str, object], options: Mapping[str, An
     """rad/s of the speed step."""
     identified = result.get("identified")
     inertia = identified.get("inertia_kgm2") if isinstance(identified, dict) else None
-    name = drive.profile.procedures.torque_constant
-    if not isinstance(inertia, float) or inertia <= 0 or name is None or not drive.profile.has("rated_current"):
+    torque = _step_torque(drive)
+    if not isinstance(inertia, float) or inertia <= 0 or torque is None:
         return DEFAULT_STEP_RAD_S
-    torque_constant = float(drive.read(name).physical)
-    current = _step_current(drive)
     omega = TWO_PI * float(options.get("bandwidth", 75))
-    step = current * torque_constant / (inertia * omega)
+    step = torque / (inertia * omega)
     return min(max(step, 1.0), MAX_STEP_RAD_S) if step > 0 else DEFAULT_STEP_RAD_S
+
+
+def _step_torque(drive: Drive) -> float | None:
+    """N·m of the step: the step current × the motor's torque constant, else (the encoTRive) the motor rated torque
+    6076h at most STEP_MAX_CURRENT_SHARE of the max current 6073h (‰ of the rated); None: neither is known."""
+    name, profile = drive.profile.procedures.torque_constant, drive.profile
+    if name is not None and profile.has("rated_current"):
+        return _step_current(drive) * float(drive.read(name).physical)
+    if not profile.has("rated_torque"):
+        return None
+    rated = float(drive.read("rated_torque").raw) / 1000.0
+    if not profile.has("max_current"):
+        return STEP_CURRENT_SHARE * rated if rated > 0 else None
+    maximum = rated * float(drive.read("max_current").raw) / 1000.0
+    return min(STEP_CURRENT_SHARE * rated, STEP_MAX_CURRENT_SHARE * maximum) if rated > 0 else None
 
 
 def _step_current(drive: Drive) -> float:
@@ -108,32 +138,38 @@ def _step_current(drive: Drive) -> float:
 def _speed_step(drive: Drive, step_rad_s: float) -> dict[str, object]:
     """Profile velocity, enabled at standstill, then SPEED_STEPS recorded steps of the target, alternating in
     direction; the first step's metrics, and the bandwidth of their mean frequency response."""
-    ramp = units_per_revolution(drive) * STEP_RAMP_REV_S2
+    ramp = _acceleration(drive, STEP_RAMP_REV_S2)
     base = round(user_speed(drive, BASE_SHARE * step_rad_s))
     top = base + round(user_speed(drive, step_rad_s))
     values = {"target_velocity": 0, "profile_acceleration": ramp, "profile_deceleration": ramp}
-    _prepare(drive, MODE_PV, values | _speed_limit(drive, 2 * abs(top)))
+    _prepare(drive, MODE_PV, values | _speed_limit(drive, 2 * abs(top)) | _ramp_limits(drive, ramp))
     recordings = []
     try:
-        for n in range(SPEED_STEPS):
+        for n in range(SPEED_STEPS if drive.profile.recorder is not None else STREAM_SPEED_STEPS):
             sign = 1 if n % 2 == 0 else -1
             recordings.append(_recorded_step(drive, sign * base, sign * top))
     finally:
         drive.write("target_velocity", 0)
-    return _speed_result(recordings, _measurement_filters(drive))
+    return _speed_result(recordings, _measurement_filters(drive), aligned=drive.profile.recorder is not None)
 
 
-def _speed_result(recordings: list[Recording], filters: tuple[float, ...]) -> dict[str, object]:
+def _speed_result(recordings: list[Recording], filters: tuple[float, ...], aligned: bool = True) -> dict[str, object]:
     """The metrics of the first step that settled, and the bandwidth of the mean frequency response of all that
     settled: a step that did not (a limit switch in its way, an axis that oscillates) says nothing about the loop's
-    bandwidth, and is listed with None."""
+    bandwidth, and is listed with None.  Steps recorded by TPDOs (not ``aligned``: each has its own fraction of a
+    period between set-point and sample, so their mean response is smeared) give the median of their bandwidths."""
     metrics = [step_metrics(*recording, filters) for recording in recordings]
     settled = [n for n, one in enumerate(metrics) if one.settling_time_s is not None]
     windows = [window(*recordings[n]) for n in settled]
     shown = settled[0] if settled else 0
+    found = [one.bandwidth_hz for one in metrics if one.settling_time_s is not None and one.bandwidth_hz is not None]
+    if aligned:
+        bandwidth = mean_bandwidth([w for w in windows if w is not None], filters) if settled else None
+    else:
+        bandwidth = round(statistics.median(found), 1) if found else None
     return {
         **metrics[shown].as_dict(),
-        "bandwidth_hz": mean_bandwidth([w for w in windows if w is not None], filters) if settled else None,
+        "bandwidth_hz": bandwidth,
         "bandwidth_steps_hz": [one.bandwidth_hz if n in settled else None for n, one in enumerate(metrics)],
         "capture": _shown(*recordings[shown], "rpm"),
     }
@@ -151,11 +187,10 @@ def _recorded_step(drive: Drive, start: int, end: int) -> Recording:
 
     definition = CaptureDefinition(
         channels=("target_velocity", "velocity_actual"),
-        period_us=PERIOD_US,
-        samples=SAMPLES,
-        trigger=Trigger("target_velocity", "rising" if end > start else "falling", (start + end) / 2),
+        trigger=Trigger(_source(drive, "target_velocity"), "rising" if end > start else "falling", (start + end) / 2),
         pre_trigger_pct=PRE_TRIGGER_PCT,
         timeout_s=10.0,
+        **_timing(drive),
     )
     capture = _record(drive, definition, step, lambda: drive.write("target_velocity", 0))
     rpm = speed_rad_s(drive, 1.0) * RPM  # one user unit/s in rpm
@@ -175,11 +210,10 @@ def _position_step(drive: Drive) -> dict[str, object]:
     distance = round(units * POSITION_STEP_REV)
     definition = CaptureDefinition(
         channels=("position_demand", "position_actual"),
-        period_us=PERIOD_US,
-        samples=SAMPLES,
-        trigger=Trigger("position_demand", "rising", start + distance / 2),
+        trigger=Trigger(_source(drive, "position_demand"), "rising", start + distance / 2),
         pre_trigger_pct=PRE_TRIGGER_PCT,
         timeout_s=10.0,
+        **_timing(drive),
     )
     capture = _record(drive, definition, lambda: _move(drive, distance), lambda: None)
     times = capture.times_s()
@@ -209,6 +243,33 @@ def _prepare(drive: Drive, mode: int, values: Mapping[str, float]) -> None:
     drive.submit_write_all(writes).future.result()
     set_state(drive, State.OPERATION_ENABLED)
     time.sleep(SETTLE_S)
+
+
+def _timing(drive: Drive) -> dict[str, Any]:
+    """Period, samples and source of a step's recording: the drive's recorder, else synchronous TPDOs."""
+    if drive.profile.recorder is not None:
+        return {"period_us": PERIOD_US, "samples": SAMPLES}
+    return {"period_us": STREAM_PERIOD_US, "samples": STREAM_SAMPLES, "source": "tpdo"}
+
+
+def _source(drive: Drive, name: str) -> str:
+    """The trigger's object: a name for the recorder, the channel's address for TPDOs (the server matches the
+    channels it receives by address)."""
+    return name if drive.profile.recorder is not None else object_key(drive.variable(name))
+
+
+def _acceleration(drive: Drive, rev_s2: float) -> float:
+    """An acceleration in the drive's own unit (the profile's, e.g. the encoTRive's rpm/s, else units/s²)."""
+    unit = drive.profile.acceleration_unit_rad_s2
+    return rev_s2 * TWO_PI / unit if unit else rev_s2 * units_per_revolution(drive)
+
+
+def _ramp_limits(drive: Drive, ramp: float) -> dict[str, float]:
+    """Raise the maximum acceleration and deceleration (the encoTRive's 60C5h / 60C6h bound the profile's ramps) to
+    the step's, if they are lower (put back afterwards): a ramp the drive slowed down would be part of the
+    measured loop."""
+    names = [name for name in ("max_acceleration", "max_deceleration") if drive.profile.has(name)]
+    return {name: ramp for name in names if float(drive.read(name).raw) < ramp}
 
 
 def _speed_limit(drive: Drive, needed: float) -> dict[str, float]:
@@ -263,6 +324,9 @@ def _monitor_filter(drive: Drive) -> float | None:
 def _loop_speed_filter(drive: Drive) -> float | None:
     procedures = drive.profile.procedures
     name = procedures.speed_measurement_filter
+    loop = drive.profile.speed_loop
+    if name is None and loop is not None and loop.speed_filter is None and loop.inertia_setting is not None:
+        return 1.0 / (TWO_PI * loop.fixed_speed_filter_s)  # the encoTRive's fixed speed filter
     if name is None or not drive.profile.has(name):
         return None
     tau = procedures.speed_measurement_filter_s.get(int(drive.read(name).raw))

@@ -16,9 +16,8 @@ from pathlib import Path
 from servostudio.formats.objectfile import (
     ObjectEntry,
     ObjectFileError,
-    format_object_file,
-    parse_object_file,
 )
+from servostudio.formats.parameterfile import format_drive_file, parse_drive_file
 from servostudio.formats.textfile import FILE_ENCODING
 from servostudio.od import ObjectDictionary, OutOfRange, SaveType, Variable, WrongType
 from servostudio.services.projects.devices import parameter_files
@@ -69,7 +68,7 @@ class AxisValues:
             path = directory / file_name
             text = path.read_text(encoding=FILE_ENCODING) if path.is_file() else ""
             try:
-                entries = parse_object_file(text, str(path), check)
+                entries = parse_drive_file(file_name, text, str(path), check)
             except ObjectFileError as error:
                 raise FileFormatError(error.file, error.line, error.reason) from None
             values.files[file_name] = {(entry.index, entry.sub): entry for entry in entries}
@@ -150,7 +149,7 @@ class AxisValues:
         texts: dict[str, str] = {}
         for file_name in sorted(self.changed):
             try:
-                texts[file_name] = format_object_file(self.files[file_name].values())
+                texts[file_name] = format_drive_file(file_name, self.files[file_name].values())
             except ValueError as error:
                 raise ParameterRefused(f"{file_name}: {error}") from None
         for file_name, text in texts.items():

@@ -12,10 +12,12 @@ first gap (a capture's samples are contiguous) and at most ``MAX_SAMPLES``.
 
 from __future__ import annotations
 
+import json
 import time
 from collections import deque
 from collections.abc import Callable
 from dataclasses import dataclass, replace
+from itertools import islice
 from threading import Lock
 
 from servostudio.drive.access import Drive
@@ -26,14 +28,15 @@ from servostudio.services.scope.capture import ChannelInfo
 from servostudio.services.scope.definition import CaptureDefinition, split_channel
 from servostudio.services.scope.plan import CaptureRefused
 from servostudio.services.scope.recorder import Report
-from servostudio.services.scope.stream import TAKE_SECONDS, StreamResult, TpdoStream, _Receiver
+from servostudio.services.scope.stream import TAKE_SECONDS, Column, StreamResult, TpdoStream, _Receiver
 from servostudio.services.scope.stream_plan import MAX_SAMPLES, Bus, StreamPlan, plan_stream
 from servostudio.services.scope.window import Sample
 
 #: channels per axis a roll streams at most
 ROLL_CHANNELS = 4
-#: a SYNC some TPDO has not answered for this long is lost (a drive answers within a period or two)
-LOSS_SECONDS = 0.25
+#: a SYNC some TPDO has not answered for this long is lost: a drive answers within a period or two, and frames a
+#: busy host reads late are still whole — only a silence this long is a drive or bus gone
+LOSS_SECONDS = 1.0
 #: after a run ended, frames of its last SYNCs may still arrive: the roll waits them out before counting again
 SETTLE_SECONDS = 0.05
 #: how long the roll looks for a lost link at a time (the cancel and the end are checked in between)
@@ -59,13 +62,31 @@ def roll_plan(drive: Drive, axes: Callable[[int], Drive], definition: CaptureDef
     return plan_stream(drive, axes, rolling, Bus(bitrate), "tpdo")
 
 
+@dataclass
+class _Entry:
+    """An event of the feed and its JSON text, encoded by the first reader that sends it, for every reader."""
+
+    event: Event
+    text: str | None = None
+
+    def encoded(self) -> tuple[Event, str]:
+        if self.text is None:
+            self.text = encode(self.event)
+        return self.event, self.text
+
+
+def encode(event: Event) -> str:
+    """An event as the roll's socket sends it: compact JSON, as Starlette's ``send_json`` spells it."""
+    return json.dumps(event, separators=(",", ":"), ensure_ascii=False)
+
+
 class RollFeed:
     """The roll's events for its readers, each with its own cursor; a reader too slow for ``keep`` events is told
     what it missed (a gap), never given a silent hole. An endless roll (no ``seconds``) is there for its readers:
     when the last one leaves (a closed tab, a lost network), ``join`` says so and the roll is stopped."""
 
     def __init__(self, keep: int = FEED_EVENTS, endless: bool = False) -> None:
-        self._events: deque[Event] = deque(maxlen=keep)
+        self._events: deque[_Entry] = deque(maxlen=keep)
         self._count = 0
         self._lock = Lock()
         self.ended = False
@@ -80,31 +101,32 @@ class RollFeed:
 
     def put(self, event: Event) -> None:
         with self._lock:
-            self._events.append(event)
+            self._events.append(_Entry(event))
             self._count += 1
             self.ended = self.ended or event["type"] == "end"
 
-    def since(self, cursor: int) -> tuple[list[Event], int]:
-        """The events after the first ``cursor`` ones, and the new cursor."""
+    def since(self, cursor: int) -> tuple[list[tuple[Event, str]], int]:
+        """The events after the first ``cursor`` ones, each with its JSON text (`encode`: once for all readers,
+        outside the lock the roll puts its events under), and the new cursor."""
         with self._lock:
             first = self._count - len(self._events)
-            fresh = list(self._events)[max(cursor - first, 0) :]
-            missed: list[Event] = [
-                {"type": "gap", "reason": f"this client fell behind: {first - cursor} batches dropped"}
-            ]
-            return (missed if cursor < first else []) + fresh, self._count
+            fresh = list(islice(self._events, max(cursor - first, 0), None))
+            count = self._count
+        missed: Event = {"type": "gap", "reason": f"this client fell behind: {first - cursor} batches dropped"}
+        return ([(missed, encode(missed))] if cursor < first else []) + [entry.encoded() for entry in fresh], count
 
 
 @dataclass
 class _Gated(_Receiver):
-    """A TPDO's frames from ``open_at`` on: an answer to a SYNC before the run (the probe of the nodes' state,
-    a run that ended) may arrive late and would shift every sample by one."""
+    """A TPDO's frames from ``open_at`` on (of its mapping's length, as every receiver takes them): an answer to a
+    SYNC before the run (the probe of the nodes' state, a run that ended) may arrive late and would shift every
+    sample by one."""
 
     open_at: float = 0.0
 
     def on_frame(self, cob_id: int, data: bytes, timestamp: float) -> None:
         if time.monotonic() >= self.open_at:
-            self.frames.append(bytes(data))
+            super().on_frame(cob_id, data, timestamp)
 
 
 @dataclass
@@ -185,7 +207,7 @@ class RollStream(TpdoStream):
             complete = min(complete, self.total - run.base - run.delivered)
         if complete <= 0:
             return
-        samples = [self._sample(k) for k in range(complete)]
+        columns = self._columns(0, complete)
         for receiver in self.receivers:
             del receiver.frames[:complete]
         self.taken += complete
@@ -194,20 +216,22 @@ class RollStream(TpdoStream):
         instants = run.sync.sent or [time.monotonic()]
         last = len(instants) - 1
         sent = instants[min(run.delivered, last)], instants[min(run.delivered + complete - 1, last)]
-        self.feed(self._batch(run.base + run.delivered, samples, sent))
-        self._keep(samples)
+        self.feed(self._batch(run.base + run.delivered, columns, sent))
+        self._keep(columns)
         run.delivered += complete
         run.progress_at = time.monotonic()
 
-    def _batch(self, seq: int, samples: list[Sample], sent: tuple[float, float]) -> Event:
-        columns = [[info.physical(row[n]) for row in samples] for n, info in enumerate(self.channels)]
-        self.samples += len(samples)
-        return {"type": "samples", "seq": seq, "count": len(samples), "values": columns,
+    def _batch(self, seq: int, columns: list[Column], sent: tuple[float, float]) -> Event:
+        count = len(columns[0])
+        self.samples += count
+        values = [info.physical_all(column) for info, column in zip(self.channels, columns, strict=True)]
+        return {"type": "samples", "seq": seq, "count": count, "values": values,
                 "synced_at": [sent[0] + self._wall, sent[1] + self._wall]}  # fmt: skip
 
-    def _keep(self, samples: list[Sample]) -> None:
+    def _keep(self, columns: list[Column]) -> None:
         if self.recording:
-            self.recorded += samples[: MAX_SAMPLES - len(self.recorded)]
+            room = MAX_SAMPLES - len(self.recorded)
+            self.recorded += zip(*(column[:room] for column in columns), strict=True)
             self.recording = len(self.recorded) < MAX_SAMPLES
 
     def _silent(self) -> str:

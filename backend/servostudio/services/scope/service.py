@@ -24,7 +24,7 @@ from datetime import UTC, datetime
 from servostudio.drive.access import Drive
 from servostudio.drive.sync import MIN_PERIOD_S
 from servostudio.drive.tpdo import tpdo_slots
-from servostudio.errors import Conflict, NotFound
+from servostudio.errors import NotFound
 from servostudio.services.bus import BusConnection, Job, JobRegistry
 from servostudio.services.cancel import Cancellation, Cancelled
 from servostudio.services.scope.capture import Capture, ChannelInfo, DriveIdentity, build_capture
@@ -49,10 +49,6 @@ Node = tuple[str, int]
 
 class UnknownCapture(NotFound):
     """No capture of that id in the server's memory (never made, or one of the oldest, forgotten)."""
-
-
-class CaptureRunning(Conflict):
-    """A capture job is running on the node already."""
 
 
 def identity_of(connection: BusConnection, drive: Drive) -> DriveIdentity:
@@ -132,7 +128,7 @@ def capture(drive: Drive, identity: DriveIdentity, definition: CaptureDefinition
     if isinstance(plan, StreamPlan):
         return stream_once(drive, plan, identity, report, cancellation, axes)
     if isinstance(plan, MultiPlan):
-        run = MultiRecorderCapture(plan, drive.engine.link, operational or _not_operational)
+        run = MultiRecorderCapture(plan, drive.engine.link, operational or _not_operational, bitrate)
         return run.run(report, cancellation, identity)
     session = session_of(drive)
     session.configure(plan)
@@ -205,8 +201,8 @@ class ScopeService:
         self.keep = keep
         self._captures: OrderedDict[str, Capture] = OrderedDict()
         self._running: dict[Node, Job] = {}
-        self._sync: dict[str, Job] = {}  # the job producing each bus's SYNC (TPDO captures and rolls)
         self._feeds: OrderedDict[str, RollFeed] = OrderedDict()
+        self._leads: dict[str, tuple[Job, Drive]] = {}  # the trigger drive of each triggered multi-axis capture
         self._numbers = itertools.count(1)
         self._lock = threading.Lock()
 
@@ -256,31 +252,27 @@ class ScopeService:
         def work(progress: Callable[[dict[str, object]], None], cancellation: Cancellation) -> object:
             if isinstance(plan, MultiPlan):
                 operational = lambda other: connection.nmt_state(other) == "OPERATIONAL"  # noqa: E731
-                return self._run_axes(drive, plan, identity, _on_node(progress, node), cancellation, operational)
+                return self._run_axes(drive, plan, identity, _on_node(progress, node), cancellation, operational,
+                                      connection.spec.bitrate)  # fmt: skip
             return self._run(drive, plan, identity, _on_node(progress, node), cancellation, connection.drive)
 
         nodes = plan.nodes if isinstance(plan, StreamPlan | MultiPlan) else (drive.node,)
         sync = isinstance(plan, StreamPlan) and plan.source == "tpdo"
-        return self._claim(connection.id, nodes, lambda: jobs.start("scope", work), sync)
+        job = self._claim(connection, nodes, lambda: jobs.start("scope", work), sync)
+        if isinstance(plan, MultiPlan) and plan.triggered:  # a force is the trigger drive's: the others follow it
+            with self._lock:
+                self._leads = {key: lead for key, lead in self._leads.items() if lead[0].state == "running"}
+                self._leads[job.id] = (job, plan.axes[0].drive)
+        return job
 
-    def _claim(self, bus: str, nodes: tuple[int, ...], start: Callable[[], Job], sync: bool = False) -> Job:
-        """Start a job that holds ``nodes`` (none of which may run a capture or a roll already) and, through TPDOs,
-        the bus's SYNC: a second SYNC producer would make every drive answer both, each capture's samples then
-        no longer one per period."""
-        held = [(bus, other) for other in nodes]
+    def _claim(self, connection: BusConnection, nodes: tuple[int, ...], start: Callable[[], Job],
+               sync: bool = False) -> Job:  # fmt: skip
+        """Start a job that holds ``nodes`` and, through TPDOs, the bus's SYNC — refused with 409 naming the job (a
+        capture, a roll, a frequency response …) that holds one of them (the bus's claims, ``services/bus/claims.py``);
+        the scope's own jobs are noted per node for ``stop`` and ``status``."""
+        job = connection.claims.start(nodes, start, sync)
         with self._lock:
-            for other in held:
-                running = self._running.get(other)
-                if running is not None and running.state == "running":
-                    raise CaptureRunning(f"node {other[1]}: capture {running.id} is running; stop it first")
-            producer = self._sync.get(bus)
-            if sync and producer is not None and producer.state == "running":
-                raise CaptureRunning(f"bus {bus}: capture {producer.id} sends the SYNC its TPDOs answer (one SYNC "
-                                     "producer per bus); stop it first, or capture these channels with it")  # fmt: skip
-            job = start()
-            self._running.update(dict.fromkeys(held, job))
-            if sync:
-                self._sync[bus] = job
+            self._running.update(dict.fromkeys(((connection.id, node) for node in nodes), job))
         return job
 
     def start_roll(self, jobs: JobRegistry, connection: BusConnection, drive: Drive, definition: CaptureDefinition,
@@ -296,7 +288,7 @@ class ScopeService:
                                 record)  # fmt: skip
             return self._roll(stream, identity, _on_node(progress, node), cancellation, feed)
 
-        job = self._claim(connection.id, plan.nodes, lambda: jobs.start("scope-roll", work), sync=True)
+        job = self._claim(connection, plan.nodes, lambda: jobs.start("scope-roll", work), sync=True)
         with self._lock:
             self._feeds[job.id] = feed
             while len(self._feeds) > KEEP_FEEDS:
@@ -343,9 +335,10 @@ class ScopeService:
         return {"capture": made[-1], "captures": len(made), "bus": identity.bus, "node": identity.node}
 
     def _run_axes(self, drive: Drive, plan: MultiPlan, identity: DriveIdentity, report: Report,
-                  cancellation: Cancellation, operational: Callable[[int], bool]) -> dict[str, object]:  # fmt: skip
+                  cancellation: Cancellation, operational: Callable[[int], bool],
+                  bitrate: int | None = None) -> dict[str, object]:  # fmt: skip
         """A recorder capture of several axes; the result says how the recorders were armed."""
-        run = MultiRecorderCapture(plan, drive.engine.link, operational)
+        run = MultiRecorderCapture(plan, drive.engine.link, operational, bitrate)
         made = self.remember(run.run(report, cancellation, identity))
         report({"stage": "captured", "capture": made})
         assert run.armed is not None
@@ -367,9 +360,14 @@ class ScopeService:
         except KeyError:
             raise UnknownCapture(f"no capture {capture_id!r} (the server keeps the latest {self.keep})") from None
 
-    def force(self, drive: Drive) -> str:
-        """Make the next sample the trigger sample (while the recorder fills or waits); the status after it."""
-        session = session_of(drive)
+    def force(self, drive: Drive, bus: str | None = None) -> str:
+        """Make the next sample the trigger sample (while the recorder fills or waits); the status after it. In a
+        triggered capture of several axes running on the node it is the trigger drive's recorder that is forced
+        (the others follow it, as they follow its trigger)."""
+        with self._lock:
+            job = self._running.get((bus, drive.node)) if bus is not None else None
+        lead = self._leads.get(job.id) if job is not None and job.state == "running" else None
+        session = session_of(lead[1] if lead is not None else drive)
         session.command("force")
         return session.status()
 

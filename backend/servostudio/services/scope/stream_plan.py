@@ -148,6 +148,11 @@ def stream_channels(drive: Drive, axes: Axes, definition: CaptureDefinition) -> 
 
 def plan_stream(drive: Drive, axes: Axes, definition: CaptureDefinition, bus: Bus, source: str = "auto") -> StreamPlan:
     """The TPDO plan when every node's channels fit its TPDOs (``source`` tpdo or auto), else the poll plan."""
+    if not drive.profile.canopen:
+        raise CaptureRefused(
+            f"node {drive.node} is a {drive.profile.fieldbus} drive ({drive.profile.device}): the scope's captures "
+            "and roll mode need a CANopen drive (TPDOs at the SYNC, a recorder, or PDO-mappable objects to poll)"
+        )
     if definition.mode != "single":
         raise CaptureRefused(f"mode {definition.mode}: normal and auto re-arm need the drive's recorder")
     channels = stream_channels(drive, axes, definition)

@@ -14,11 +14,12 @@ The scalings of the gains are the project's (docs/control-loops.md), as for the 
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from typing import Any
 
 from servostudio.od.model import Value
 from servostudio.sim.drive import errors
-from servostudio.sim.drive.behaviour import DriveBehaviour
+from servostudio.sim.drive.behaviour import DriveBehaviour, _clamp_i16
 from servostudio.sim.drive.device_map import _COMMON_402, IDENTIFIED_PLANT, DeviceProfile
 from servostudio.sim.drive.errors import DriveError
 from servostudio.sim.drive.statemachine import STOP_CURRENT_LIMIT, STOP_NONE, STOP_SLOW_DOWN_RAMP
@@ -130,6 +131,21 @@ class Cd1kBehaviour(DriveBehaviour):
     def read_units(self) -> UnitScaling:
         increments = float(self.p.get("encoder_increments", 0)) or float(self.physics.counts_per_turn)
         return UnitScaling(increments)
+
+    def set_hardware_data(self) -> None:
+        """Also the drive's current rating 6510h/4 (0.01 A, read-only hardware data the dictionary gives no value):
+        the plant's peak current, the rating the currents' shares are taken of."""
+        super().set_hardware_data()
+        address = self.profile.address("drive_rating")
+        if address is not None and address in self.store and not self.store.od[address].default_for(self.store.node_id):
+            self.store.set_factory(address[0], address[1], round(self.plant.peak_current * 100))
+            self.snapshot()
+
+    def _measurement_functions(self) -> dict[str, Callable[[], int]]:
+        """0x6078 in ‰ of the drive's current rating 6510h/4, as its dictionary gives it (docs/devices.md §9)."""
+        functions = super()._measurement_functions()
+        functions["current_actual"] = lambda: _clamp_i16(1000.0 * self._current_filter / self.drive_max_current)
+        return functions
 
     def read_currents(self) -> tuple[float, float, float]:
         rating = float(self.p.get("drive_rating", 0)) * 0.01 or self.plant.peak_current

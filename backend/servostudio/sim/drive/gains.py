@@ -174,5 +174,47 @@ def tuned_gains(
     )
 
 
+INERTIA_SETTING_UNIT = 1e-7
+"""encoTRive 0x2F02,8 Θi: kg·m² per count (g·cm²; the manual's example motor has Θi = 510·10⁻⁷ kg·m², p. 218)."""
+CURRENT_CYCLE_S = 1e-4
+"""encoTRive Tc = 1/fc, the current controller's cycle: 10 kHz (the maximum ramp duration's 36 000 000 cycles of
+1/fc are one hour, p. 219)."""
+INERTIA_DESIGN_CROSSOVER = 1.0 / ((2.0 * math.pi) ** 2 * CURRENT_CYCLE_S)
+"""ωd = 1/((2π)²·Tc) = 253 rad/s: the encoTRive speed loop's gain crossover when Θi equals the true inertia."""
+INERTIA_INTEGRAL_DIVISOR = 8.0
+"""The encoTRive speed controller's PI zero at ωd/8."""
+
+
+@dataclass(frozen=True)
+class InertiaSpeedGains:
+    """The encoTRive speed controller derived from Θi (physical units: A per rad/s, A per rad, A per rad/s², 1/s)."""
+
+    kpv: float
+    kiv: float
+    kav: float
+    kpp: float
+
+
+def inertia_speed_gains(inertia_setting: float, rated_torque: float, rated_current: float) -> InertiaSpeedGains:
+    """The encoTRive's speed controller from its inertia setting Θi (kg·m²), 6076h MN (N·m) and 6075h iN (A, the
+    sine peak), docs/identification.md § Tuning (p. 218, the project's reading, decisions.md §6):
+
+    KP = Θi·iN / (MN·iM·2π·Tc) is the drive's gain in current measuring ranges iM per rev/s of speed error, so in A
+    per rad/s KPv = KP·iM/2π = Θi / (Kt·(2π)²·Tc) with Kt = MN/iN (iM cancels); the loop's crossover is
+    (Θi/J)·ωd.  The manual gives no integral or position gain: the PI zero at ωd/8 (a loaded axis on the factory's
+    Θi, the rotor's alone, crosses over below ωd and keeps its phase margin), KPp = ωd/10 (below the speed loop down
+    to Θi ≈ J/5), and the acceleration feed-forward KAv = Θi/Kt; the drive knows no friction (KBv = 0)."""
+    if rated_torque <= 0 or rated_current <= 0:
+        return InertiaSpeedGains(0.0, 0.0, 0.0, 0.0)
+    torque_constant = rated_torque / rated_current
+    kpv = inertia_setting * INERTIA_DESIGN_CROSSOVER / torque_constant
+    return InertiaSpeedGains(
+        kpv=kpv,
+        kiv=kpv * INERTIA_DESIGN_CROSSOVER / INERTIA_INTEGRAL_DIVISOR,
+        kav=inertia_setting / torque_constant,
+        kpp=INERTIA_DESIGN_CROSSOVER / 10.0,
+    )
+
+
 def _u16(value: float) -> int:
     return max(0, min(U16_MAX, round(value)))

@@ -11,10 +11,13 @@ from __future__ import annotations
 import logging
 import threading
 from collections.abc import Callable
+from typing import TYPE_CHECKING
 
 from servostudio.errors import ServoStudioError
-from servostudio.transport.profibus.master import DpMaster
 from servostudio.transport.profibus.ppo import Ppo
+
+if TYPE_CHECKING:  # the master makes its exchanges (DpMaster.exchange)
+    from servostudio.transport.profibus.master import DpMaster
 
 log = logging.getLogger(__name__)
 

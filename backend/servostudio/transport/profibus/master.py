@@ -20,6 +20,8 @@ import serial
 from servostudio.errors import CommunicationError, Timeout, Unavailable
 from servostudio.transport.profibus import dp_services as dp
 from servostudio.transport.profibus import function_codes as fc
+from servostudio.transport.profibus.cyclic import CyclicExchange
+from servostudio.transport.profibus.interface import Inputs, LinkReport, Outputs
 from servostudio.transport.profibus.ppo import Ppo
 from servostudio.transport.profibus.telegram import BROADCAST, Frame, ShortAcknowledge, Telegram, encode
 from servostudio.transport.profibus.telegram_decoder import TelegramDecoder
@@ -178,6 +180,19 @@ class DpMaster:
         if not diag.ready_for_data_exchange or diag.master_address != self.address:
             raise DpRefused(address, "parameterisation", describe_diag(diag))
         return diag
+
+    def exchange(
+        self,
+        address: int,
+        ppo: Ppo,
+        outputs: Outputs,
+        inputs: Inputs,
+        on_link: LinkReport,
+        period: float,
+        watchdog: float | None,
+    ) -> CyclicExchange:
+        """The cyclic Data_Exchange with one slave (`interface.DpLine.exchange`)."""
+        return CyclicExchange(self, address, ppo, outputs, inputs, on_link, period, watchdog)
 
     # -- one SRD transaction ----------------------------------------------------------------------------------
 

@@ -3,7 +3,7 @@
  * configuration gives them (the input and its function: `lib/io-names.ts`) once those are known.
  */
 
-import { extractBits, fieldLabel } from "../../lib/bits";
+import { type BitField, extractBits, fieldLabel } from "../../lib/bits";
 import { h } from "../../lib/dom";
 import type { IoNames } from "../../lib/io-names";
 import type { Entry } from "../../lib/od";
@@ -26,33 +26,46 @@ export function digitalIo(props: DigitalIoProps): HTMLElement {
     h("div", { class: "panel-body" }, groups.length ? groups : h("div", { class: "muted" }, "This dictionary has no digital I/O objects.")));
 }
 
+/** CiA 402 gives bits 0–15 of the I/O words their meaning for the drive (limit switches, home, interlock; the
+ * brake) and leaves bits 16–31 to the device's own terminals. */
+const DEVICE_BITS_FROM = 16;
+
 function ioGroup(title: string, entry: Entry, props: DigitalIoProps): HTMLElement {
   const word = () => props.word(entry);
+  const key = title.toLowerCase();
+  const terminals = entry.variable.bits.filter((field) => field.first >= DEVICE_BITS_FROM);
+  const functions = entry.variable.bits.filter((field) => field.first < DEVICE_BITS_FROM);
+  const split = terminals.length > 0 && functions.length > 0;
   return h("div", { style: { marginBottom: "8px" } },
     h("div", { class: "muted", style: { marginBottom: "4px" } }, `${title} · ${props.address(entry)}`, () => {
       const value = word();
       return value === null ? "" : ` = 0x${value.toString(16).toUpperCase().padStart(8, "0")}`;
     }),
-    h("div", { class: "io-row", "data-testid": `io-${title.toLowerCase()}` }, entry.variable.bits.map((field) => {
-      const named = () => (title === "Inputs" ? props.names?.()?.inputs : props.names?.()?.outputs)?.get(field.first) ?? null;
-      return h("span", {
-        class: () => {
-          const value = word();
-          return `led ${value !== null && extractBits(value, field.first, field.last) !== 0 ? "on" : ""}`;
-        },
-        title: () => `bit ${fieldLabel(field)}: ${named() ?? field.name}`,
-      }, () => {
-        const label = named();
-        return label ? configuredName(label) : shortName(field.name);
-      });
-    })));
+    h("div", { class: "io-row", "data-testid": `io-${key}` }, (split ? terminals : entry.variable.bits).map((field) => led(title, field, word, props))),
+    split ? h("div", { class: "io-row", "data-testid": `io-${key}-functions`, title: "What the drive makes of its inputs (CiA 402 bits 0–15)" },
+      h("span", { class: "muted" }, "drive sees:"), functions.map((field) => led(title, field, word, props))) : null);
+}
+
+function led(title: string, field: BitField, word: () => number | null, props: DigitalIoProps): HTMLElement {
+  const named = () => (title === "Inputs" ? props.names?.()?.inputs : props.names?.()?.outputs)?.get(field.first) ?? null;
+  return h("span", {
+    class: () => {
+      const value = word();
+      return `led ${value !== null && extractBits(value, field.first, field.last) !== 0 ? "on" : ""}`;
+    },
+    title: () => `bit ${fieldLabel(field)}: ${named() ?? field.name}`,
+  }, () => {
+    const label = named();
+    return label ? configuredName(label) : shortName(field.name);
+  });
 }
 
 /** An LED label from the I/O configuration's "IN3: Positive limit switch" → "IN3 LIM+", "INPUT0 / LS+" → "INPUT0". */
 export function configuredName(label: string): string {
   const [line, function_] = label.split(": ");
   const name = line.split(" ")[0];
-  return function_ ? `${name} ${shortName(function_)}` : name;
+  const short = function_ ? shortName(function_) : "";
+  return short && short.toLowerCase() !== name.toLowerCase() ? `${name} ${short}` : name;
 }
 
 /** A short LED label from a bit name: "IN1", "Negative limit switch" → "LIM−", "Home switch" → "Home". */

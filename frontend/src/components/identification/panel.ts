@@ -72,7 +72,7 @@ function bandwidthRow(bandwidth: State<number | null>): HTMLElement[] {
         const text = (event.target as HTMLInputElement).value.trim();
         bandwidth.val = text === "" ? null : Number(text);
       } }),
-    h("span", { class: "muted" }, " Hz closed speed-loop bandwidth (drives with gain objects: written, then verified by a step)"))];
+    h("span", { class: "muted" }, " Hz closed speed-loop bandwidth (gains, or the encoTRive's inertia setting: written, then verified by a step)"))];
 }
 
 export async function startIdentification(model: ProceduresModel, client: IdentificationClient, current: IdentificationRun,

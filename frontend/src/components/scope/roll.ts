@@ -19,7 +19,7 @@ const CHECK_DELAY_MS = 300;
 
 export function rollView(model: ScopeModel, scope: Scope): { element: HTMLElement; dispose(): void } {
   const roll = createRoll();
-  const plot = rollPlot(roll);
+  const plot = rollPlot(roll, scope);
   let timer: ReturnType<typeof setTimeout> | undefined;
   scope.run(() => effect(() => {
     void [model.draft.channels.val, roll.period.val];
@@ -32,7 +32,7 @@ export function rollView(model: ScopeModel, scope: Scope): { element: HTMLElemen
       h("div", { class: "muted", "data-testid": "scope-roll-budget" }, () => budgetText(roll.budget.val)),
       messageView(roll.message),
       plot.element,
-      gapList(plot.progress))));
+      gapList(plot.gaps))));
   return {
     element,
     dispose: () => {
@@ -72,9 +72,9 @@ export function budgetText(plan: CapturePlan | null): string {
     `${stream.nodes.join(", ")}: ${formatNumber(stream.frames_per_s, 6)} frames/s, bus load ${formatNumber(stream.bus_load * 100, 3)} % of ${rate} (limit 70 %)`;
 }
 
-function gapList(progress: State<RollProgress>): HTMLElement {
+function gapList(listed: State<RollGap[]>): HTMLElement {
   return h("div", { "data-testid": "scope-roll-gaps" }, () => {
-    const gaps = progress.val.gaps;
+    const gaps = listed.val;
     if (gaps.length === 0) return h("span", { class: "muted" }, "No gap: every sample arrived.");
     return h("ul", { class: "message error" }, gaps.map((gap) => h("li", { "data-testid": "scope-roll-gap" }, gapText(gap))));
   });

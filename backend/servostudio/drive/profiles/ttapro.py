@@ -1,0 +1,130 @@
+"""Transtechnik TTA-PRO (Infranor-built positioner) on PROFIBUS-DP: its PNUs by the semantic names the CANopen
+drives use where the TTA-PRO has the quantity, so services never see a PNU (docs/profibus.md §9).
+
+Source: *TTA-PRO Profibus Communication Profile*, Issue 1.4 (the parameter list `eds/ttapro.pnu`, extraction in
+`shared/spec/ttapro-profibus.md`). Addresses are (PNU, IND). Names whose CANopen meaning differs in unit or value
+are not reused: the speed and current monitors are shares of the maximum speed and of the drive rating, not CiA 402
+velocity and current (`speed_monitor`, `current_monitor`), the positioner mode (PNU 720) is no 0x6060 mode and the
+homing configuration (766) no 0x6098 method. The status and control words are PZD1 words, not parameters: the
+parameter list holds them at addresses beyond every PNU (`od.pnu_model.CONTROL_WORD`, `STATUS_WORD`) and the PKW
+engine carries them through PZD. Their bits 0-3 and 7 (status bits 0-6) are CiA 402's, so `statusword` and
+`controlword` name them and the CiA 402 state control and the motion guard work unchanged (docs/profibus.md §12).
+"""
+
+from __future__ import annotations
+
+from servostudio.drive.profibus.pzd import ControlBit
+from servostudio.drive.profiles.base import Addressing, DeviceProfile
+from servostudio.drive.profiles.ttapro_faults import (
+    ERRORS,
+    POSITIONER_ERRORS_FIRST,
+    POWER_STAGE_CODE,
+    POWER_STAGE_FIRST,
+    WARNINGS,
+)
+from servostudio.od.model import SaveType
+from servostudio.od.pnu_model import CONTROL_WORD, STATUS_WORD
+
+PROFIBUS_DP = "PROFIBUS-DP"
+QUICK_STOP = 0x0002
+"""CiA 402's quick-stop command (`drive.cia402.Command.QUICK_STOP`)."""
+PARAMETER_FILE = "TTAPAR.TXT"
+"""The backup of the E parameters (saved by PNU 729), docs/profibus.md §10."""
+
+_OBJECTS: dict[str, tuple[int, int]] = {
+    # motor and commissioning
+    "pole_pairs": (700, 0),
+    "phase_order": (701, 0),
+    "sensor_offset": (702, 0),
+    "auto_phasing": (704, 0),
+    "stop_current_share": (705, 0),
+    "dc_bus_voltage": (706, 0),
+    # current limits (shares of the drive rating, as the CD1-k's)
+    "max_current_share": (710, 0),
+    "rated_current_share": (711, 0),
+    "current_limitation": (713, 0),
+    "drive_rating": (715, 0),
+    # current loop
+    "kp_current_d": (716, 0),
+    "ki_current_d": (717, 0),
+    "kp_current_q": (718, 0),
+    "ki_current_q": (719, 0),
+    # modes, speed, brake, saving
+    "positioner_mode": (720, 0),
+    "max_motor_speed": (721, 0),
+    "speed_ramp": (723, 0),
+    "brake_on_delay": (726, 0),
+    "brake_off_delay": (727, 0),
+    "manual_brake": (728, 0),
+    "save_parameters": (729, 0),
+    # speed and position loop gains
+    "kp_speed": (730, 0),
+    "ki_speed": (731, 0),
+    "kp_position": (732, 0),
+    "kf_position": (733, 0),
+    "current_filter": (734, 0),
+    "anti_resonance_filter": (735, 0),
+    "auto_tuning": (736, 0),
+    "ka_position": (737, 0),
+    "kf2_position": (738, 0),
+    "kc_speed": (739, 0),
+    "kd_speed": (830, 0),
+    "kd_speed_filter": (831, 0),
+    "speed_gain_scaling": (832, 0),
+    # position
+    "position_resolution": (740, 0),
+    "following_error_window": (741, 0),
+    "positioner_configuration": (742, 0),
+    "software_position_limit_max": (747, 0),
+    "software_position_limit_min": (748, 0),
+    "following_error_actual": (749, 0),
+    "position_window": (757, 0),
+    "profile_velocity": (760, 0),
+    "profile_acceleration": (761, 0),
+    "profile_deceleration": (762, 0),
+    "jog_speed": (763, 0),
+    "jog_acceleration": (764, 0),
+    "jog_deceleration": (765, 0),
+    "homing_configuration": (766, 0),
+    "target_position": (767, 0),
+    "home_offset": (768, 0),
+    "position_actual": (774, 0),
+    # monitors, versions, faults
+    "drive_error_code": (755, 0),
+    "digital_inputs": (769, 0),
+    "software_version": (770, 0),
+    "profibus_software_version": (771, 0),
+    "positioner_error_code": (773, 0),
+    "resolver_position": (775, 0),
+    "speed_monitor": (776, 0),
+    "current_monitor": (777, 0),
+    "power_stage_fault_code": (778, 0),
+    "warning_code": (873, 0),
+    # process data (PZD1), not PNUs
+    "controlword": (CONTROL_WORD, 0),
+    "statusword": (STATUS_WORD, 0),
+}
+
+TTAPRO = DeviceProfile(
+    device="ttapro",
+    objects=_OBJECTS,
+    #: PNU 729 is a procedure: writing it saves every E parameter (the drive refuses it while enabled, error 17)
+    procedure_values={"save": ("save_parameters", 1)},
+    parameter_files={PARAMETER_FILE: SaveType.DRIVEPAR},
+    addressing=Addressing(node_ids=range(1, 126), reason="PROFIBUS-DP station addresses are 1-125"),
+    #: what moves the axis or changes how it moves: the PZD control word (the guard judges it through the CiA 402
+    #: transitions: its bits 0-3 and 7 are CiA 402's), the jog speed, and the writes that turn the motor or free the
+    #: axis by themselves: the auto-phasing and auto-tuning procedures, the manual brake release (a vertical axis falls)
+    motion_objects=frozenset({"controlword", "auto_phasing", "auto_tuning", "manual_brake", "jog_speed"}),
+    fieldbus=PROFIBUS_DP,
+    controlword_fixed=ControlBit.PROFIBUS_CONTROL | ControlBit.NO_STOP | ControlBit.NO_INTERMEDIATE_STOP,
+    #: the quick test's jog: CW8 / CW9 at the jog speed (PNU 763, rpm) while the bit stays set
+    jog_bits=(ControlBit.JOG_PLUS, ControlBit.JOG_MINUS),
+    controlword_commands={QUICK_STOP: ControlBit.ON | ControlBit.NO_OFF2},
+    #: faults polled (no EMCY): PNU 773 and 778 with the manual's texts, warnings PNU 873 (``ttapro_faults``)
+    error_words=(("positioner_error_code", POSITIONER_ERRORS_FIRST), ("power_stage_fault_code", POWER_STAGE_FIRST)),
+    coded_error_bits=(POWER_STAGE_CODE,),
+    errors=ERRORS,
+    warning_word="warning_code",
+    warnings=WARNINGS,
+)

@@ -1,0 +1,108 @@
+"""A PROFIBUS-DP bus through the unchanged REST routes (docs/profibus.md §9): open it by its spec, scan finds the
+simulated TTA-PRO at station 5, PNUs read and written by address and by profile name, refusals before sending and
+negative PKW replies as readable errors, the parameter file downloaded, and scope roll refused."""
+
+from __future__ import annotations
+
+import pytest
+from tests.support.access import admin_app, api_client
+from tests.support.jobs_api import finished
+from tests.support.profibus_line import ttapro_line
+
+from servostudio.services.settings import Settings
+
+NODE = "/api/buses/pb/nodes/5"
+
+
+@pytest.fixture(scope="module")
+def line():
+    with ttapro_line(5) as line:
+        yield line
+
+
+@pytest.fixture(scope="module")
+def client(tmp_path_factory, line):
+    root = tmp_path_factory.mktemp("api-profibus")
+    app = admin_app(Settings(projects_dir=root / "store", static_dir=root / "no-ui", buses=[]), root / "data")
+    with api_client(app) as test_client:
+        opened = test_client.post("/api/buses", json={"spec": line.spec, "id": "pb"})
+        assert opened.status_code == 201 and opened.json()["kind"] == "profibus" and opened.json()["connected"]
+        yield test_client
+
+
+def test_a_scan_finds_station_5_as_a_ttapro(client):
+    found = client.post("/api/buses/pb/scan")
+    assert found.status_code == 200
+    assert found.json() == [
+        {"node": 5, "device": "ttapro", "device_type": None, "vendor_id": 0, "product_code": 0x00C7, "revision": None,
+         "serial_number": None, "device_name": "TTA-PRO", "hardware_version": None, "software_version": None}
+    ]  # fmt: skip
+    assert [node["node"] for node in client.get("/api/buses/pb").json()["nodes"]] == [5]
+
+
+def test_pnus_are_read_and_written_by_address_and_by_profile_name(client, line):
+    read = client.get(f"{NODE}/objects/PNU700").json()
+    assert (read["label"], read["raw"]) == ("PNU 700 Number of motor pole pairs", 4)
+    written = client.put(f"{NODE}/objects/kp_speed", json={"value": 321})
+    assert written.status_code == 200 and written.json()["label"] == "PNU 730 Proportional speed loop gain KP2"
+    assert line.slaves[5].memory.get(730) == 321
+    assert client.get(f"{NODE}/objects/828,1").json()["raw"] == 0x1308
+
+
+def test_refusals_before_sending_and_from_the_drive_are_readable(client, line):
+    out_of_range = client.put(f"{NODE}/objects/PNU700", json={"value": 99})
+    assert (
+        out_of_range.status_code == 422
+        and "PNU 700 Number of motor pole pairs: 99 is outside 1..32" in (out_of_range.json()["detail"])
+    )
+    refused = client.put(f"{NODE}/objects/positioner_mode", json={"value": 3})
+    assert refused.status_code == 409
+    assert refused.json()["detail"] == "node 5, PNU 720: lower or upper limit exceeded (PKW error 2)"
+    assert client.get(f"{NODE}/objects/PNU918").status_code == 404  # no such PNU in the TTA-PRO's list
+
+
+def test_the_parameter_file_downloads_and_uploads_in_its_own_syntax(client, line):
+    text = client.get(f"{NODE}/files/TTAPAR.TXT")
+    assert text.status_code == 200
+    lines = text.text.splitlines()
+    assert lines[0].startswith("; TTAPAR.TXT of node 5 (TTA-PRO)") and "700,0=4" in lines and len(lines) == 81
+    bad = client.put(f"{NODE}/files/TTAPAR.TXT", content=b"760,0=1200\n761,0=x\n")
+    assert bad.status_code == 422 and bad.json()["detail"].startswith("TTAPAR.TXT:2: value 'x' is not an integer")
+    assert line.slaves[5].memory.get(760) != 1200  # refused whole: the valid first line was not written either
+    good = client.put(f"{NODE}/files/TTAPAR.TXT", params={"store": "false"}, content=b"760,0=1200\n")
+    assert good.status_code == 200 and good.json()["ok"] and line.slaves[5].memory.get(760) == 1200
+
+
+def test_the_bus_wide_backup_and_restore_jobs_carry_ttapar(client, line):
+    directory = client.app.state.server.settings.projects_dir / "line-backup"
+    backup = client.post("/api/buses/pb/backup", json={"directory": str(directory), "nodes": [5]})
+    assert backup.status_code == 202 and finished(client, backup.json()["id"])["state"] == "done"
+    saved = (directory / "node5" / "TTAPAR.TXT").read_text().splitlines()
+    assert len(saved) == 81 and f"760,0={line.slaves[5].memory.get(760)}" in saved
+    client.put(f"{NODE}/objects/PNU760", json={"value": 777})
+    restore = client.post("/api/buses/pb/restore", json={"directory": str(directory), "nodes": [5]})
+    assert restore.status_code == 202 and finished(client, restore.json()["id"])["state"] == "done"
+    assert f"760,0={line.slaves[5].memory.get(760)}" in saved and line.slaves[5].memory.get(760) != 777
+
+
+def test_scope_roll_and_nmt_are_refused_with_the_reason(client):
+    roll = client.post(f"{NODE}/scope/roll", json={"channels": ["position_actual"], "period_us": 1000, "seconds": 1})
+    assert roll.status_code == 422
+    assert roll.json()["detail"].startswith("node 5 is a PROFIBUS-DP drive (ttapro): the scope's captures and roll")
+    nmt = client.post("/api/buses/pb/nmt", json={"command": "start", "node": 5})
+    assert nmt.status_code == 409 and nmt.json()["detail"].startswith("bus pb is a PROFIBUS-DP line: an NMT command")
+
+
+def test_a_project_axis_edits_the_ttapro_offline(client, line):
+    created = client.post("/api/projects", json={"name": "pb", "buses": [{"name": "pb", "interface": line.spec}]})
+    assert created.status_code == 201, created.text
+    axis = {"name": "X", "device": "ttapro", "node_id": 5, "bus": "pb", "revision": created.json()["revision"]}
+    added = client.post("/api/projects/pb/axes", json=axis)
+    assert added.status_code == 201, added.text
+    values = {"PNU721": 3000, "730": 100, "PNU700": 8}
+    written = client.put("/api/projects/pb/axes/X/parameters", json={"values": values})
+    assert written.status_code == 200 and {row["file"] for row in written.json()["parameters"]} == {"TTAPAR.TXT"}
+    refused = client.put("/api/projects/pb/axes/X/parameters", json={"values": {"PNU700": 99}})
+    assert refused.status_code == 422 and "99 is outside 1..32" in refused.json()["detail"]
+    store = client.app.state.server.settings.projects_dir
+    assert (store / "pb" / "X" / "TTAPAR.TXT").read_text().splitlines() == ["700,0=8", "721,0=3000", "730,0=100"]
