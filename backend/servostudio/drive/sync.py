@@ -2,8 +2,11 @@
 
 Each drive samples its synchronous TPDOs when the SYNC frame reaches it, and every drive of the bus receives the
 same frame at the same instant: that is what aligns the channels of several axes. The producer runs on a thread
-of its own and schedules each frame from the first one (``start + k × period``), so a late frame does not delay
-the ones after it; every send instant is noted, and `jitter_ns` says how far the frames were from that schedule.
+of its own and schedules each frame on a grid from the first one (``start + slot × period``), so a late frame does
+not delay the ones after it; every send instant is noted, and `jitter_ns` says how far the frames were from their
+slots. A thread held up longer than a period (a loaded host) skips the slots it missed, as a bus master does,
+instead of sending them in a burst: two SYNCs are never less than half a period apart, because a burst would give
+a free-running drive samples at one instant and a SYNC-locked one a cycle out of step.
 
 With ``answered`` (how many SYNCs the consumers have seen the answers of) the producer stays at most
 ``MAX_AHEAD`` SYNCs ahead of them: a bus that cannot carry the answers in time (or a simulated bus behind real
@@ -14,6 +17,7 @@ lower priority (SDO included) for good.
 from __future__ import annotations
 
 import logging
+import math
 import threading
 import time
 from collections.abc import Callable
@@ -51,6 +55,7 @@ class SyncProducer:
         self.link = link
         self.period_s = period_s
         self.sent: list[float] = []  # monotonic send instants
+        self.slots: list[int] = []  # each one's slot on the grid (a gap: slots skipped)
         self.error: str | None = None
         self._answered = answered
         #: called with k just before SYNC k is sent (the frequency response's RPDO, applied at that SYNC)
@@ -71,18 +76,24 @@ class SyncProducer:
     def count(self) -> int:
         return len(self.sent)
 
+    @property
+    def skipped(self) -> int:
+        """Slots the producer missed (held up beyond a period) and left out."""
+        return self.slots[-1] + 1 - len(self.slots) if self.slots else 0
+
     def jitter_ns(self) -> int:
-        """The largest distance of a SYNC from its scheduled instant (the first frame's time + k × period)."""
+        """The largest distance of a SYNC from its slot (the first frame's time + slot × period)."""
         if not self.sent:
             return 0
         first = self.sent[0]
-        return round(max(abs(t - first - k * self.period_s) for k, t in enumerate(self.sent)) * 1e9)
+        offsets = (abs(t - first - slot * self.period_s) for slot, t in zip(self.slots, self.sent, strict=True))
+        return round(max(offsets) * 1e9)
 
     def _run(self) -> None:
         start = time.monotonic()
-        k = 0
+        slot = k = 0
         while not self._stop.is_set():
-            delay = start + k * self.period_s - time.monotonic()
+            delay = start + slot * self.period_s - time.monotonic()
             if delay > 0 and self._stop.wait(delay):
                 return
             while self._answered is not None and k - self._answered() >= MAX_AHEAD:
@@ -95,8 +106,11 @@ class SyncProducer:
             except LinkDownError as error:
                 self.error = str(error)
                 return
-            self.sent.append(time.monotonic())
+            sent = time.monotonic()
+            self.sent.append(sent)
+            self.slots.append(slot)
             k += 1
+            slot = max(slot + 1, math.ceil((sent - start) / self.period_s + 0.5))
 
 
 def announce_cycle(drive: Drive, period_s: float) -> int | None:

@@ -1,7 +1,7 @@
 import { afterEach, beforeEach, describe, expect, it, vi } from "vitest";
 import { HoldToRun, KEEPALIVE_MS, type PageView } from "../client/motion";
 import { holdButton } from "../components/motion/hold-button";
-import { motionText } from "../components/motion/model";
+import { laterMotion, motionText } from "../components/motion/model";
 
 interface FakePage {
   shown: boolean;
@@ -102,5 +102,25 @@ describe("motion status line", () => {
       reason: "hold-to-run: no keepalive from client c for 104 ms",
     };
     expect(motionText(motion)).toBe("Jog stopped · position 512 — hold-to-run: no keepalive from client c for 104 ms");
+  });
+});
+
+describe("the motion kept when answers and events cross", () => {
+  const base = { motion: "m7", bus: "sim", node: 2, kind: "home" as const, reason: null };
+  const running = { ...base, state: "running" as const, position: null };
+  const done = { ...base, state: "done" as const, position: null };
+  const read = { ...base, state: "done" as const, position: 4096 };
+
+  it("keeps the end when the start's answer arrives after the end's event", () => {
+    expect(laterMotion(done, running)).toBe(done);
+    expect(laterMotion(read, done)).toBe(read);
+  });
+
+  it("takes every later state, and any other motion", () => {
+    expect(laterMotion(running, done)).toBe(done);
+    expect(laterMotion(done, read)).toBe(read);
+    const next = { ...running, motion: "m8" };
+    expect(laterMotion(read, next)).toBe(next);
+    expect(laterMotion(read, null)).toBeNull();
   });
 });

@@ -191,6 +191,12 @@ class Bench:
 
     # -- observation ----------------------------------------------------------------------------------------------
 
+    def settled_position(self) -> int:
+        """0x6064 once the axis settled: with 0x6067 = 0 a POS ends with its reference on the target, while the
+        axis is still a few counts away from it (more on a loaded host, whose SDO read comes sooner in virtual time)."""
+        self.run_for(0.05)
+        return self.read(0x6064)
+
     def rows(self, mark: int = 0) -> list[Row]:
         with self.network.lock:
             return self.probe.rows[mark:]

@@ -74,7 +74,7 @@ def collapsed(numbers: list[int]) -> list[int]:
 
 def test_counter_loop_runs_1_2_1_2_3(bench: Bench):
     assert run_program(bench, COUNTER_LOOP) == [1, 2, 1, 2, 3, -1]
-    assert abs(bench.read(0x6064) - 5 * REV // 2) <= 2  # five relative moves of half a revolution, settling
+    assert abs(bench.settled_position() - 5 * REV // 2) <= 2  # five relative moves of half a revolution
 
 
 @pytest.mark.parametrize(("input_8", "order"), [(True, [1, 2, 3, -1]), (False, [1, 4, -1])])

@@ -69,7 +69,7 @@ def test_a_start_condition_is_waited_for_when_seq_link_is_minus_1(bench: Bench):
     bench.set_physical_inputs(0b1)
     rows = bench.wait_program_end(mark)
     assert first(rows, lambda row: row[PHASE] & END, "the end")
-    assert abs(bench.read(0x6064) - REV) <= 2
+    assert abs(bench.settled_position() - REV) <= 2
 
 
 def test_the_seq_output_lasts_at_least_the_minimum_sequence_pulse(bench: Bench):

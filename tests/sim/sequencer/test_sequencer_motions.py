@@ -32,6 +32,7 @@ from .conftest import (
 
 PERIOD = 250e-6
 TIMING = 1.5 * PERIOD  # a duration measured between two control periods
+STATUS_REFRESH = 4  # control periods: the status word 0x6041 is published every 1 ms
 OUTPUT_1 = 1 << 1  # Output="......1." sets bit 1
 VIRTUAL_MASTER = (0x3906, 0)
 
@@ -73,7 +74,11 @@ def test_pos_sequence_arrives_at_its_target_with_the_output_switched_at_its_trig
     assert switched is at_phase(rows, phase)  # in the very control period the phase is reached
     assert at_phase(rows, END)[POSITION] == 3 * REV
     assert at_phase(rows, END).time - at_phase(rows, INPOS).time == pytest.approx(0.050, abs=TIMING)
-    assert bench.read(0x6041) & 0x1400 == 0x1400  # SW10 program over at its target, SW12 POS
+    over = rows.index(first(rows[rows.index(at_phase(rows, END)) :], lambda row: row[EXECUTED] == -1, "the end"))
+    published = rows[over + STATUS_REFRESH]  # the drive refreshes its status word every 1 ms
+    assert published[STATUS_WORD] & 0x1400 == 0x1400  # SW10 program over at its target, SW12 POS
+    bench.run_for(0.002)
+    assert bench.read(0x6041) & 0x1400 == 0x1400
 
 
 def test_inpos_trigger_switches_when_the_position_is_inside_the_window(bench: Bench):
@@ -124,7 +129,7 @@ def test_home_sequence_runs_homing_on_the_index_and_returns_to_the_reference(ben
     bench.enable_sequence_mode()
     rows = bench.wait_program_end(bench.start(1))
     assert phases_seen(rows) == [BEGIN, HOLD | INPOS | END]
-    assert abs(bench.read(0x6064) - 1000) <= 2 and bench.read(0x3218) == 1
+    assert abs(bench.settled_position() - 1000) <= 2 and bench.read(0x3218) == 1
 
 
 def test_home_sequence_on_the_negative_limit_switch_runs_into_the_switch(bench: Bench):

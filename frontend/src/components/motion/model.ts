@@ -33,7 +33,7 @@ export class QuickMotion {
     const { bus, node, live, scope, view } = context;
     this.hold = new HoldToRun(live, () => serverBus(bus), node, () => this.release("the tab was hidden or lost focus"), view);
     scope.add(live.on("motion", (event) => {
-      if (event.bus === serverBus(bus) && event.node === node) this.motion.val = event;
+      if (event.bus === serverBus(bus) && event.node === node) this.show(event);
     }));
     scope.add(() => this.hold.end());
   }
@@ -41,7 +41,7 @@ export class QuickMotion {
   async load(): Promise<void> {
     const { bus, node, device } = this.context;
     await Promise.all([
-      motionApi.current(bus, node).then((motion) => (this.motion.val = motion)),
+      motionApi.current(bus, node).then((motion) => this.show(motion)),
       motionApi.limits(bus, node).then((limits) => (this.limits.val = limits)),
       motionApi.homingMethods(device).then((methods) => (this.methods.val = methods)).catch(() => undefined),
     ]).catch((error: unknown) => (this.error.val = errorText(error)));
@@ -56,7 +56,7 @@ export class QuickMotion {
     }
     this.pressed = true;
     try {
-      this.motion.val = await start();
+      this.show(await start());
     } catch (error) {
       this.hold.end();
       this.pressed = false;
@@ -78,10 +78,14 @@ export class QuickMotion {
 
   async stop(): Promise<void> {
     try {
-      this.motion.val = await motionApi.stop(this.context.bus, this.context.node);
+      this.show(await motionApi.stop(this.context.bus, this.context.node));
     } catch (error) {
       this.error.val = `Stop: ${errorText(error)}`;
     }
+  }
+
+  private show(motion: Motion | null): void {
+    this.motion.val = laterMotion(this.motion.rawVal, motion);
   }
 
   async setLimits(limits: Partial<MotionLimits>): Promise<boolean> {
@@ -105,6 +109,21 @@ export class QuickMotion {
   home(method: number, velocity: number | null): Promise<void> {
     return this.press("Homing", () => motionApi.home(this.context.bus, this.context.node, method, velocity));
   }
+}
+
+/**
+ * What the status line keeps when news of a motion arrives. An HTTP answer can come after the event of a later
+ * change (a homing over before the request that started it was answered, on a loaded host): a motion never goes
+ * back from ended to running, nor loses the position its end was read with.
+ */
+export function laterMotion(shown: Motion | null, news: Motion | null): Motion | null {
+  if (!shown?.motion || !news?.motion || shown.motion !== news.motion) return news;
+  return progress(news) >= progress(shown) ? news : shown;
+}
+
+function progress(motion: Motion): number {
+  if (!ENDED.has(motion.state)) return 0;
+  return motion.position === null || motion.position === undefined ? 1 : 2;
 }
 
 /** The motion as the status line says it. */
