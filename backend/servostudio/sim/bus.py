@@ -5,7 +5,9 @@ arbitration round picks the pending frame with the lowest identifier (a data fra
 same identifier, as the RTR bit is recessive), keeps it on the wire for its exact bit time (`timing.frame_bits`) and
 then delivers it to every attached station except its sender. Frames that lose arbitration wait for the next round,
 which starts as soon as the wire is free. With `bitrate=None` frames still go through arbitration rounds but take
-no time.
+no time. A station's own frames leave in the order it queued them (a CAN controller's transmit FIFO, as SocketCAN
+and USB adapters keep it): only its oldest pending frame takes part in a round, so a client's RPDO sent just before
+its SYNC is not overtaken by it. Frames queued without a sender are each a transmitter of their own.
 
 The bus is driven by the `VirtualClock` and is not thread-safe by itself: `SimulatedNetwork` serialises every access
 with its lock.
@@ -60,7 +62,7 @@ class VirtualBus:
         if not self._pending:
             self._busy = False
             return
-        winner = min(self._pending)
+        winner = min(_heads(self._pending))
         self._pending.remove(winner)
         frame, sender = winner[2], winner[3]
         self.clock.call_later(frame_duration(frame, self.bitrate), lambda: self._complete(frame, sender))
@@ -72,6 +74,19 @@ class VirtualBus:
             if station is not sender:
                 station.receive(frame, now)
         self._arbitrate()
+
+
+def _heads(pending: list[tuple[int, int, Frame, Station | None]]) -> list[tuple[int, int, Frame, Station | None]]:
+    """The frames that take part in a round: each sender's oldest (the list is in queueing order)."""
+    seen: set[int] = set()
+    heads = []
+    for entry in pending:
+        sender = entry[3]
+        if sender is None or id(sender) not in seen:
+            heads.append(entry)
+            if sender is not None:
+                seen.add(id(sender))
+    return heads
 
 
 def _priority(frame: Frame) -> int:

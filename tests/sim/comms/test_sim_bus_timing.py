@@ -59,6 +59,21 @@ def test_bit_rate_delays_delivery_and_lower_identifier_wins_arbitration():
     assert recorder.frames[1][0] == pytest.approx(first_done + frame_bits(high) / 125_000)
 
 
+def test_a_station_s_own_frames_leave_in_its_order_and_others_still_arbitrate():
+    """A client's RPDO queued before its SYNC is not overtaken by it (a transmit FIFO); another station's frame
+    with a lower identifier still wins the round it takes part in."""
+    clock = VirtualClock()
+    bus = VirtualBus(clock, bitrate=125_000)
+    client, other, recorder = Recorder(), Recorder(), Recorder()
+    bus.attach(recorder)
+    rpdo, sync, emcy = Frame(0x201, bytes(8)), Frame(0x080), Frame(0x081, bytes(8))
+    bus.transmit(rpdo, client)  # all three queued at one instant: one round
+    bus.transmit(sync, client)
+    bus.transmit(emcy, other)
+    clock.run_until(1.0)
+    assert [frame for _, frame in recorder.frames] == [emcy, rpdo, sync]
+
+
 def test_data_frame_beats_remote_frame_with_the_same_identifier():
     clock = VirtualClock()
     bus = VirtualBus(clock, bitrate=None)
