@@ -24,6 +24,7 @@ from servostudio.errors import CommunicationError, NotFound, Timeout, Unavailabl
 from servostudio.od.datatypes import DataType, decode
 from servostudio.services.bus.connections import BusConnection, NodeInfo
 from servostudio.transport.profibus.dp_services import SlaveDiag
+from servostudio.transport.profibus.scan import scan as scan_line
 
 PROBE_TIMEOUT = 0.15
 PROBE_ROUNDS = 2
@@ -143,7 +144,7 @@ def _scan_profibus(connection: BusConnection, link: ProfibusLink, nodes: range |
     candidates = [node for node in (nodes if nodes is not None else DP_STATIONS) if node != own]
     stations: dict[int, SlaveDiag] = {}
     for _ in range(PROBE_ROUNDS):  # as on CAN: a second round catches a station whose first answer was late
-        stations.update(link.master.scan([node for node in candidates if node not in stations]))
+        stations.update(scan_line(link.master, [node for node in candidates if node not in stations]))
     found = [_dp_node(connection, address, diag.ident_number) for address, diag in sorted(stations.items())]
     return _remember(connection, candidates, found, everything=nodes is None)
 

@@ -21,6 +21,7 @@ from servostudio.transport.profibus import dp_services as dp
 from servostudio.transport.profibus.dp_services import SetPrm
 from servostudio.transport.profibus.master import ByteLink, DpLinkError, DpMaster, DpNoResponse, DpRefused, prm_for
 from servostudio.transport.profibus.ppo import PPO1, PPO2
+from servostudio.transport.profibus.scan import scan
 from servostudio.transport.profibus.telegram import ED, SD1
 
 ADDRESSES = (5, 9)
@@ -51,7 +52,7 @@ def master(server: ProfibusTcpServer) -> Iterator[DpMaster]:
 
 
 def test_a_scan_finds_the_stations_and_their_ident_numbers_quickly(master: DpMaster) -> None:
-    found = master.scan(range(1, 126))
+    found = scan(master, range(1, 126))
     assert sorted(found) == list(ADDRESSES)
     assert {diag.ident_number for diag in found.values()} == {IDENT}
     assert all(diag.status_2 & dp.DIAG_PRM_REQUEST for diag in found.values())

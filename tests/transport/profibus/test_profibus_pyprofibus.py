@@ -25,6 +25,7 @@ from servostudio.transport.profibus.master import DpLinkError, DpMaster, DpNoRes
 from servostudio.transport.profibus.open import ProfibusExtraMissing, open_dp_line
 from servostudio.transport.profibus.ppo import PPO2, Ppo
 from servostudio.transport.profibus.pyprofibus_master import CONNECT_TIMEOUT, PyprofibusMaster
+from servostudio.transport.profibus.scan import scan
 from servostudio.transport.spec import parse_bus_spec
 
 ADDRESSES = (5, 9)
@@ -71,7 +72,7 @@ def test_a_scan_during_data_exchange_finds_the_stations_and_keeps_the_exchange(
     client = TtaProClient(master, 5).start()
     try:
         started = time.monotonic()
-        found = master.scan(range(3, 126))
+        found = scan(master, range(3, 126))
         elapsed = time.monotonic() - started
         assert sorted(found) == list(ADDRESSES) and {d.ident_number for d in found.values()} == {IDENT}
         assert found[9].status_2 & dp.DIAG_PRM_REQUEST  # not parameterised yet

@@ -8,28 +8,26 @@ when this master goes quiet (the tool dies, the cable is cut), as the drive's ow
 
 from __future__ import annotations
 
-import logging
-import threading
 from collections.abc import Callable
 from typing import TYPE_CHECKING
 
 from servostudio.errors import ServoStudioError
+from servostudio.transport.profibus.exchange import SlaveExchange
 from servostudio.transport.profibus.ppo import Ppo
 
 if TYPE_CHECKING:  # the master makes its exchanges (DpMaster.exchange)
     from servostudio.transport.profibus.master import DpMaster
 
-log = logging.getLogger(__name__)
-
 PERIOD = 0.002
 """Seconds between two Data_Exchanges (the TTA-PRO wants its PZD at least every few milliseconds)."""
 WATCHDOG = 0.2
 """Seconds of silence after which the slave leaves data exchange."""
-RETRY_PERIOD = 0.1
-"""Seconds between two parameterisation attempts of a lost slave."""
 
 
-class CyclicExchange:
+class CyclicExchange(SlaveExchange):
+    """The project's master's exchange: Set_Prm / Chk_Cfg itself, then one Data_Exchange per cycle; a lost slave is
+    parameterised again at its next attempt."""
+
     def __init__(
         self,
         master: DpMaster,
@@ -41,42 +39,18 @@ class CyclicExchange:
         period: float = PERIOD,
         watchdog: float | None = WATCHDOG,
     ) -> None:
+        super().__init__(address, ppo, outputs, inputs, on_link, period, watchdog)
         self.master = master
-        self.address = address
-        self.ppo = ppo
-        self._outputs = outputs
-        self._inputs = inputs
-        self._on_link = on_link
-        self.period = period
-        self.watchdog = watchdog
-        self.error: ServoStudioError | None = None
-        self.cycles = 0
-        self._stop = threading.Event()
-        self._thread: threading.Thread | None = None
 
     def start(self) -> CyclicExchange:
         """Parameterise now (errors go to the caller), then exchange in the background."""
         self._parameterise()
-        self._thread = threading.Thread(target=self._run, name=f"profibus-dx-{self.address}", daemon=True)
-        self._thread.start()
+        self._run_in_background(f"profibus-dx-{self.address}")
         return self
-
-    def stop(self) -> None:
-        self._stop.set()
-        if self._thread is not None:
-            self._thread.join()
-            self._thread = None
 
     def _parameterise(self) -> None:
         ident = self.master.slave_diag(self.address).ident_number
         self.master.parameterise(self.address, self.ppo, self.watchdog, ident)
-
-    def _run(self) -> None:
-        while not self._stop.wait(self.period if self.error is None else RETRY_PERIOD):
-            try:
-                self._step()
-            except ServoStudioError as error:
-                self._lost(error)
 
     def _step(self) -> None:
         if self.error is not None:
@@ -84,14 +58,3 @@ class CyclicExchange:
             self._recovered()
         self._inputs(self.master.data_exchange(self.address, self._outputs()))
         self.cycles += 1
-
-    def _lost(self, error: ServoStudioError) -> None:
-        if self.error is None:
-            log.warning("PROFIBUS slave %d lost: %s", self.address, error)
-        self.error = error
-        self._on_link(error)
-
-    def _recovered(self) -> None:
-        log.info("PROFIBUS slave %d back in data exchange", self.address)
-        self.error = None
-        self._on_link(None)

@@ -48,10 +48,6 @@ class DpLine(Protocol):
     address: int
     """This master's station address."""
 
-    def scan(self, addresses: range | list[int] = ..., timeout: float = ...) -> dict[int, dp.SlaveDiag]:
-        """Slave_Diag to each address; the stations that answered."""
-        ...
-
     def slave_diag(self, address: int, timeout: float | None = None, retries: int | None = None) -> dp.SlaveDiag: ...
 
     def global_control(self, command: int, group_select: int = 0) -> None: ...

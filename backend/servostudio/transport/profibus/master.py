@@ -31,9 +31,6 @@ DEFAULT_BAUDRATE = 1_500_000
 RESPONSE_TIMEOUT = 0.1
 """Seconds a station has to answer (a generous slot time: the TCP stream and the OS add latency)."""
 RETRIES = 1
-SCAN_TIMEOUT = 0.02
-"""Seconds an absent station costs a scan (no retry): 125 addresses in about 2.5 s."""
-STATION_ADDRESSES = range(1, 126)
 READ_SLICE = 0.005
 _REFUSALS = {
     fc.USER_ERROR: "user error (UE)",
@@ -134,18 +131,6 @@ class DpMaster:
         self.link.close()
 
     # -- DP services ----------------------------------------------------------------------------------------
-
-    def scan(
-        self, addresses: range | list[int] = STATION_ADDRESSES, timeout: float = SCAN_TIMEOUT
-    ) -> dict[int, dp.SlaveDiag]:
-        """Slave_Diag to each address; the stations that answered, with their ident numbers."""
-        found: dict[int, dp.SlaveDiag] = {}
-        for address in addresses:
-            try:
-                found[address] = self.slave_diag(address, timeout=timeout, retries=0)
-            except (DpNoResponse, DpRefused):
-                continue
-        return found
 
     def slave_diag(self, address: int, timeout: float | None = None, retries: int | None = None) -> dp.SlaveDiag:
         reply = self._data_reply(address, "Slave_Diag", b"", dp.SLAVE_DIAG_SAP, timeout, retries)

@@ -4,10 +4,9 @@ optional extra (`pip install servostudio[profibus]`); `open.open_dp_line` import
 serial line is opened.
 
 Public interface (`interface.DpLine`, the same as the project's `master.DpMaster`; `TtaProClient`, the bus
-connection and the scan use nothing else):
+connection and `scan.scan` use nothing else):
 
     PyprofibusMaster(port, baudrate=1_500_000, address=2, timeout=0.1, retries=1)
-      .scan(addresses=1..125, timeout=0.02) -> {address: SlaveDiag}
       .slave_diag(address, timeout=None, retries=None) -> SlaveDiag
       .global_control(command, group_select=0)
       .exchange(address, ppo, outputs, inputs, on_link, period, watchdog) -> DataExchange (start, stop, error, cycles)
@@ -48,16 +47,14 @@ from pyprofibus.phy import PhyError
 from pyprofibus.phy_serial import CpPhySerial
 from pyprofibus.util import ProfibusError
 
-from servostudio.errors import ServoStudioError
 from servostudio.transport.profibus import dp_services as dp
+from servostudio.transport.profibus.exchange import SlaveExchange
 from servostudio.transport.profibus.interface import Inputs, LinkReport, Outputs
 from servostudio.transport.profibus.master import (
     DEFAULT_BAUDRATE,
     DEFAULT_MASTER,
     RESPONSE_TIMEOUT,
     RETRIES,
-    SCAN_TIMEOUT,
-    STATION_ADDRESSES,
     DpLinkError,
     DpNoResponse,
     DpRefused,
@@ -74,8 +71,6 @@ CONNECT_TIMEOUT = 3.0
 """Seconds DPM1 has to bring a slave into data exchange when the exchange starts. Its own request timeouts are
 10-50 ms (FDL_Status, Slave_Diag, Set_Prm, Chk_Cfg): on a loaded host it repeats them, and gets there later. A
 refusal ends the start-up at once, a silent station its first Slave_Diag; only a slow line takes this long."""
-RETRY_PERIOD = 0.1
-"""Seconds between two reconnection windows of a lost slave."""
 RECONNECT_WINDOW = 0.02
 """Seconds a lost slave's DPM1 runs per window: enough for a few steps of its start-up, short enough that the
 other exchanges of the line keep their slaves' watchdogs fed."""
@@ -215,18 +210,6 @@ class PyprofibusMaster:
 
     # -- DP services ----------------------------------------------------------------------------------------
 
-    def scan(
-        self, addresses: range | list[int] = STATION_ADDRESSES, timeout: float = SCAN_TIMEOUT
-    ) -> dict[int, dp.SlaveDiag]:
-        """Slave_Diag to each address; the stations that answered, with their ident numbers."""
-        found: dict[int, dp.SlaveDiag] = {}
-        for address in addresses:
-            try:
-                found[address] = self.slave_diag(address, timeout=timeout, retries=0)
-            except (DpNoResponse, DpRefused):
-                continue
-        return found
-
     def slave_diag(self, address: int, timeout: float | None = None, retries: int | None = None) -> dp.SlaveDiag:
         request = DpTelegram_SlaveDiag_Req(da=address, sa=self.address)
         for _ in range((self.retries if retries is None else retries) + 1):
@@ -303,7 +286,7 @@ class PyprofibusMaster:
         return telegram if ok else None
 
 
-class PyprofibusExchange:
+class PyprofibusExchange(SlaveExchange):
     """The cyclic Data_Exchange of one slave by a DPM1 (`interface.DataExchange`): every `period` one output image
     out and one input image back under the line's lock; a cycle without an answer reports the slave lost
     (`DpNoResponse`, or `DpLinkError` for a failed port) and the DPM1 reconnects it by itself."""
@@ -319,23 +302,13 @@ class PyprofibusExchange:
         period: float,
         watchdog: float | None,
     ) -> None:
+        super().__init__(address, ppo, outputs, inputs, on_link, period, watchdog)
         self.master = master
-        self.address = address
-        self.ppo = ppo
-        self._outputs = outputs
-        self._inputs = inputs
-        self._on_link = on_link
-        self.period = period
-        self.watchdog = watchdog
-        self.error: ServoStudioError | None = None
-        self.cycles = 0
         self._ident = 0
         self._last_answer = 0.0
         self._generation = 0
         self._dpm: _LoggingDpm1 | None = None
         self._desc: DpSlaveDesc | None = None
-        self._stop = threading.Event()
-        self._thread: threading.Thread | None = None
 
     def start(self) -> PyprofibusExchange:
         """Slave_Diag for its ident, DPM1's start-up into data exchange now (errors go to the caller), then the
@@ -346,8 +319,7 @@ class PyprofibusExchange:
             self._dpm = self._desc = None  # the next start begins afresh
             raise DpRefused(self.address, "parameterisation", self._refusal(fault))
         self._last_answer = time.monotonic()
-        self._thread = threading.Thread(target=self._run, name=f"pyprofibus-dx-{self.address}", daemon=True)
-        self._thread.start()
+        self._run_in_background(f"pyprofibus-dx-{self.address}")
         return self
 
     def _start_up(self) -> bool:
@@ -367,19 +339,6 @@ class PyprofibusExchange:
         """Why the slave stays out of data exchange: its Slave_Diag in words, else what DPM1 reported."""
         reason = describe_diag(self.master.slave_diag(self.address))
         return fault if reason == "ready" and fault else reason
-
-    def stop(self) -> None:
-        self._stop.set()
-        if self._thread is not None:
-            self._thread.join()
-            self._thread = None
-
-    def _run(self) -> None:
-        while not self._stop.wait(self.period if self.error is None else RETRY_PERIOD):
-            try:
-                self._step()
-            except ServoStudioError as error:
-                self._lost(error)
 
     def _step(self) -> None:
         """One cycle: the line is held for at most one response timeout (a reconnection window while lost), so
@@ -447,17 +406,6 @@ class PyprofibusExchange:
         self._dpm_now()
         assert self._desc is not None
         return self._desc
-
-    def _lost(self, error: ServoStudioError) -> None:
-        if self.error is None:
-            log.warning("PROFIBUS slave %d lost: %s", self.address, error)
-        self.error = error
-        self._on_link(error)
-
-    def _recovered(self) -> None:
-        log.info("PROFIBUS slave %d back in data exchange", self.address)
-        self.error = None
-        self._on_link(None)
 
 
 def _transceiver(phy: _SerialPhy, address: int) -> DpTransceiver:
