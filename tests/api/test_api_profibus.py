@@ -5,11 +5,8 @@ negative PKW replies as readable errors, the parameter file downloaded, and scop
 from __future__ import annotations
 
 import pytest
-from tests.support.access import admin_app, api_client
 from tests.support.jobs_api import finished
-from tests.support.profibus_line import ttapro_line
-
-from servostudio.services.settings import Settings
+from tests.support.profibus_line import tool_on_line, ttapro_line
 
 NODE = "/api/buses/pb/nodes/5"
 
@@ -22,11 +19,9 @@ def line():
 
 @pytest.fixture(scope="module")
 def client(tmp_path_factory, line):
-    root = tmp_path_factory.mktemp("api-profibus")
-    app = admin_app(Settings(projects_dir=root / "store", static_dir=root / "no-ui", buses=[]), root / "data")
-    with api_client(app) as test_client:
-        opened = test_client.post("/api/buses", json={"spec": line.spec, "id": "pb"})
-        assert opened.status_code == 201 and opened.json()["kind"] == "profibus" and opened.json()["connected"]
+    with tool_on_line(tmp_path_factory.mktemp("api-profibus"), line) as test_client:
+        bus = test_client.get("/api/buses/pb").json()
+        assert bus["kind"] == "profibus" and bus["connected"]
         yield test_client
 
 

@@ -6,8 +6,13 @@ from __future__ import annotations
 from collections.abc import Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass
+from pathlib import Path
+
+from fastapi.testclient import TestClient
+from tests.support.access import admin_app, api_client
 
 from servostudio.od.pnu import builtin_parameter_list
+from servostudio.services.settings import Settings
 from servostudio.sim.plant import Plant
 from servostudio.sim.profibus.endpoints import ProfibusTcpServer
 from servostudio.sim.profibus.line import ProfibusLine
@@ -34,3 +39,13 @@ def ttapro_line(*addresses: int) -> Iterator[TtaProLine]:
     finally:
         server.stop()
         line.stop()
+
+
+@contextmanager
+def tool_on_line(root: Path, line: TtaProLine) -> Iterator[TestClient]:
+    """An administrator's REST client of a server in this process with the line opened as bus ``pb``."""
+    app = admin_app(Settings(projects_dir=root / "store", static_dir=root / "no-ui", buses=[]), root / "data")
+    with api_client(app) as client:
+        opened = client.post("/api/buses", json={"spec": line.spec, "id": "pb"})
+        assert opened.status_code == 201, opened.text
+        yield client

@@ -41,20 +41,46 @@ def decode_emergency(node: int, data: bytes, profile: DeviceProfile | None) -> E
     return Emergency(node, code, register, manufacturer, tuple(faults))
 
 
-class BusMonitor:
+class DriveStateReporter:
+    """One ``drive_state`` event per change of a node's CiA 402 state, from status words however they were read.
+    A bus without CAN frames (a PROFIBUS-DP line) has only this part, fed by its own adapter: no NMT states."""
+
+    def __init__(self, bus: str, sink: EventSink) -> None:
+        self.bus = bus
+        self._sink = sink
+        self._lock = threading.Lock()
+        self._drive_state: dict[int, str | None] = {}
+
+    def nmt_state(self, node: int) -> str | None:
+        """None: no heartbeat or boot-up seen (on a bus without NMT, never)."""
+        return None
+
+    def report_statusword(self, node: int, statusword: int) -> None:
+        """A status word read by other means (state control): reported if the state changed."""
+        state = decode_state(statusword)
+        name = state.value if state else None
+        with self._lock:  # reader thread and request threads report concurrently: one event per change
+            changed = self._drive_state.get(node, "unknown") != name
+            self._drive_state[node] = name
+        if changed:
+            self._emit({"type": "drive_state", "node": node, "state": name, "statusword": statusword})
+
+    def _emit(self, event: dict[str, object]) -> None:
+        self._sink({"bus": self.bus, "time": time.time(), **event})
+
+
+class BusMonitor(DriveStateReporter):
     """Watches the error-control and EMCY frames of one bus and reports what happens as event dicts."""
 
     def __init__(self, link: BusLink, sink: EventSink, profile_of: Callable[[int], DeviceProfile | None]) -> None:
+        super().__init__(link.name, sink)
         self.link = link
-        self._sink = sink
         self._profile_of = profile_of
-        self._lock = threading.Lock()
         self._last_seen: dict[int, float] = {}
         self._period: dict[int, float] = {}
         self._nmt_state: dict[int, str] = {}
         self._lost: set[int] = set()
         self._statusword_cob: dict[int, int] = {}
-        self._drive_state: dict[int, str | None] = {}
         for node in range(1, 128):
             link.subscribe(0x080 + node, self._on_emergency)
             link.subscribe(0x700 + node, self._on_error_control)
@@ -73,23 +99,10 @@ class BusMonitor:
         self._statusword_cob[node] = cob_id
         self.link.subscribe(cob_id, self._on_statusword_pdo)
 
-    def report_statusword(self, node: int, statusword: int) -> None:
-        """A status word read by other means (state control): reported if the state changed."""
-        state = decode_state(statusword)
-        name = state.value if state else None
-        with self._lock:  # reader thread and request threads report concurrently: one event per change
-            changed = self._drive_state.get(node, "unknown") != name
-            self._drive_state[node] = name
-        if changed:
-            self._emit({"type": "drive_state", "node": node, "state": name, "statusword": statusword})
-
     def _on_statusword_pdo(self, cob_id: int, data: bytes, timestamp: float) -> None:
         for node, watched in self._statusword_cob.items():
             if watched == cob_id and len(data) >= 2:
                 self.report_statusword(node, int.from_bytes(data[:2], "little"))
-
-    def _emit(self, event: dict[str, object]) -> None:
-        self._sink({"bus": self.link.name, "time": time.time(), **event})
 
     def _on_emergency(self, cob_id: int, data: bytes, timestamp: float) -> None:
         node = cob_id - 0x080

@@ -101,6 +101,9 @@ STATUS_WORD = 0x801
 """The PZD1 words as dictionary entries, at addresses no PNU can have (the PKW PNU field has 11 bits: 0..2047), so
 a `Drive` reads the status word and writes the control word like any object and the motion guard judges the control
 word where it judges every write (docs/profibus.md §12); the PKW engine carries them through PZD, not PKW."""
+POSITION_SET_POINT = 0x802
+"""PZD5-6 of the PPO write: the position set point of the default command mapping (PNU 829 IND 2 = 0x22FF), which
+replaces PNU 767 every cycle (L488-491, L2486), so a move's target must travel here, not through PKW."""
 
 
 class PzdVariable(Variable):
@@ -139,19 +142,21 @@ def _process_data() -> list[DictObject]:
         (CONTROL_WORD, "PZD1 control word STW", Access.RW, "the enabling commands and the positioner's (L427-478)"),
         (STATUS_WORD, "PZD1 status word ZSW", Access.RO, "the enabling stage and the positioner's state (L494-535)"),
     )
+    set_point = (POSITION_SET_POINT, "PZD5-6 position set point", Access.RW, "replaces PNU 767 (L488-491, L2486)")
     return [
-        DictObject(index, name, ObjectKind.VAR, PROCESS_DATA, {0: _pzd_variable(index, name, access, text)})
-        for index, name, access, text in words
+        DictObject(index, name, ObjectKind.VAR, PROCESS_DATA, {0: _pzd_variable(index, name, access, text, kind)})
+        for (index, name, access, text), kind in [
+            *((word, DataType.UNSIGNED16) for word in words),
+            (set_point, DataType.INTEGER32),
+        ]
     ]
 
 
 PROCESS_DATA = "Process data (PZD)"
 
 
-def _pzd_variable(index: int, name: str, access: Access, description: str) -> PzdVariable:
-    return PzdVariable(
-        index, 0, name, DataType.UNSIGNED16, access, group=PROCESS_DATA, description=description, parent_name=name
-    )
+def _pzd_variable(index: int, name: str, access: Access, description: str, data_type: DataType) -> PzdVariable:
+    return PzdVariable(index, 0, name, data_type, access, group=PROCESS_DATA, description=description, parent_name=name)
 
 
 def _dictionary_object(parameter: Parameter) -> DictObject:

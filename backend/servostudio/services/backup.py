@@ -426,7 +426,7 @@ def restore_text(
         table, writes = _validated_sequence_writes(drive, text)
     else:
         checked = validate_object_text(drive, text, Path(file).name if file else kind.value, kind)
-        writes = [(var, _entry_value(var, entry.value)) for entry, var, _ in checked]
+        writes = _in_restore_order(drive, [(var, _entry_value(var, entry.value)) for entry, var, _ in checked])
     _check_can_store(drive, store)
     if cancel is not None and cancel.requested:
         result.outcomes = [ObjectOutcome(var.label, _shown(value), "not written") for var, value in writes]
@@ -453,6 +453,17 @@ def restore_text(
         result.error, result.cancelled = str(error), True
     result.seconds = time.monotonic() - started
     return result
+
+
+def _in_restore_order(drive: Drive, writes: list[tuple[Variable, object]]) -> list[tuple[Variable, object]]:
+    """The profile's ``restore_first`` objects ahead, in its order (what the others are scaled by must be in place
+    before them, the TTA-PRO's 721 and 740/870), the rest in the file's order."""
+    first = [drive.profile.address(name) for name in drive.profile.restore_first]
+    return sorted(writes, key=lambda write: _rank(first, write[0].key))
+
+
+def _rank(first: list[tuple[int, int]], address: tuple[int, int]) -> int:
+    return first.index(address) if address in first else len(first)
 
 
 def _check_can_store(drive: Drive, store: bool) -> None:

@@ -15,15 +15,14 @@ from servostudio.services.motion import MotionGuard
 
 
 def drive_state(connection: BusConnection, drive: Drive) -> dict[str, object]:
-    """CiA 402 state, status word and the NMT state the node last announced."""
+    """CiA 402 state, status word and the NMT state the node last announced (a PROFIBUS-DP drive has no NMT state:
+    none is given)."""
     state, statusword = control.read_state(drive)
     connection.report_statusword(drive.node, statusword)
-    return {
-        "node": drive.node,
-        "state": state.value if state else None,
-        "statusword": statusword,
-        "nmt_state": connection.nmt_state(drive.node),
-    }
+    answer: dict[str, object] = {"node": drive.node, "state": state.value if state else None, "statusword": statusword}
+    if drive.profile.canopen:
+        answer["nmt_state"] = connection.nmt_state(drive.node)
+    return answer
 
 
 def change_state(connection: BusConnection, motion: MotionGuard, drive: Drive, target: str) -> dict[str, object]:

@@ -86,6 +86,17 @@ describe("the what-if logic of the Bode page", () => {
     expect(slow.step!.speed.at(-1)!).toBeCloseTo(1, 1);
     expect(fast.step).toBeNull(); // no rigid fit, no step
   });
+
+  it("predicts from the plant's coherent points only: an incoherent spike moves no predicted marker", () => {
+    const params = paramsWith(LOOP as never, draftOf(LOOP as never));
+    const clean = predict(barePlant({ points: plantPoints() }, T), null, params);
+    const points = plantPoints().map((p, n) => (n % 7 === 3 ? { ...p, magnitude_db: p.magnitude_db + 15, coherence: 0.5 } : p));
+    const spiked = predict(barePlant({ points }, T), null, params);
+    expect(spiked.markers).toEqual(clean.markers);
+    expect(spiked.gainCrossoverHz).toBe(clean.gainCrossoverHz);
+    expect(spiked.closed.freq).toHaveLength(50); // the curve still shows every point
+    expect(predict(barePlant({ points: points.map((p) => ({ ...p, coherence: 0.5 })) }, T), null, params).markers.bandwidth_hz).toBeNull();
+  });
 });
 
 describe("the Bode figure", () => {

@@ -72,6 +72,13 @@ describe("dashboard model", () => {
     expect(dashboard.cell(voltage).val).toEqual({ value: { raw: 325 }, error: "timeout" });
   });
 
+  it("says a drive without NMT fields (a PROFIBUS-DP drive) has no NMT instead of an unknown NMT state", async () => {
+    api.state.mockResolvedValue({ statusword: 0x0240 });
+    const { model: dashboard } = model();
+    await dashboard.start();
+    expect(dashboard.nmt.val).toBe("no NMT (PROFIBUS-DP)");
+  });
+
   it("shows a drive it cannot reach with the project's bus to open, and is no longer reachable once offline", async () => {
     api.state.mockRejectedValue(new Error("no bus 'sim'"));
     const { model: dashboard } = model();

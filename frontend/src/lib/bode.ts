@@ -16,7 +16,7 @@
 
 import { db, mul, unit, unwrapDeg } from "./whatif/complex";
 import { loopResponses, paramsOf, responseOf, withoutFilters, type BodePoint, type LoopParams, type Response, type SpeedLoopReading } from "./whatif/loop";
-import { crossingDown, markersOf, type Markers } from "./whatif/markers";
+import { coherentPart, crossingDown, markersOf, type Markers } from "./whatif/markers";
 import { stepResponse, type PlantFit, type StepResponse } from "./whatif/step";
 
 /** What the sliders change; the rest of the loop stays as the drive has it. */
@@ -65,7 +65,7 @@ export function paramsWith(loop: SpeedLoopReading, draft: Draft): LoopParams {
 export function usablePoints(points: MeasuredPoint[]): BodePoint[] {
   return points.filter((p): p is BodePoint & { coherence: number | null } =>
     [p.freq_hz, p.magnitude_db, p.phase_deg].every((v) => typeof v === "number" && Number.isFinite(v)) && (p.freq_hz ?? 0) > 0)
-    .map((p) => ({ freq_hz: p.freq_hz, magnitude_db: p.magnitude_db, phase_deg: p.phase_deg }));
+    .map((p) => ({ freq_hz: p.freq_hz, magnitude_db: p.magnitude_db, phase_deg: p.phase_deg, coherence: p.coherence }));
 }
 
 /** Control periods between a measured plant and the model's P: the measurement's lead, the model's hold and difference. */
@@ -75,7 +75,7 @@ export const MEASURED_PLANT_SHIFT_PERIODS = 2;
 export function barePlant(measurement: PlantMeasurement, periodS: number): Response {
   const measured = responseOf(usablePoints(measurement.points));
   const shift = (f: number) => unit(-2 * Math.PI * f * periodS * MEASURED_PLANT_SHIFT_PERIODS);
-  const plant = { freq: measured.freq, value: measured.value.map((value, n) => mul(value, shift(measured.freq[n]))) };
+  const plant = { ...measured, value: measured.value.map((value, n) => mul(value, shift(measured.freq[n]))) };
   return measurement.plant_includes_filters ? withoutFilters(plant, measurement.gains?.current_filters_hz ?? [], periodS) : plant;
 }
 
@@ -96,10 +96,11 @@ export function stepDuration(bandwidthHz: number | null): number {
 export function predict(plant: Response, fit: PlantFit | null, params: LoopParams): Prediction {
   const { openLoop: open, closedLoop: closed } = loopResponses(plant, params);
   const markers = markersOf(closed, open, plant);
+  const marked = coherentPart(open);
   return {
     open, closed, markers,
-    gainCrossoverHz: crossingDown(open.freq, open.value.map(db), 0),
-    phaseCrossoverHz: crossingDown(open.freq, unwrapDeg(open.value), -180),
+    gainCrossoverHz: crossingDown(marked.freq, marked.value.map(db), 0),
+    phaseCrossoverHz: crossingDown(marked.freq, unwrapDeg(marked.value), -180),
     step: fit ? stepResponse(params, fit, stepDuration(markers.bandwidth_hz)) : null,
   };
 }

@@ -43,6 +43,7 @@ from servostudio.services.frequency.tpdo_source import (
     plan_response,
 )
 from servostudio.services.procedures.run import disable
+from servostudio.services.scope import NoRecorder
 from servostudio.sim.plant import Plant
 
 CD1K_PER_REV = 65536
@@ -210,3 +211,16 @@ def test_the_latency_is_found_from_the_read_back_and_a_read_back_not_the_excitat
     assert latency([float(sent(99 + k)) for k in range(200)], sent, 100) == 1  # answered before it applied
     with pytest.raises(NotApplied, match="not the excitation sent"):
         latency([float(sent(100 + k // 2)) for k in range(200)], sent, 100)  # values a SYNC late half the time
+
+
+def test_a_drive_whose_cycle_does_not_follow_the_sync_is_refused_before_anything_is_written(frequency_bench):
+    """The encoTRive has neither a recorder nor 0x1006: its TPDO answers come at instants its own clock picks, and a
+    Bode through them is tens of dB and degrees off the hidden plant (docs/frequency-response.md §8). Refused, not
+    measured wrong."""
+    bench = frequency_bench(Plant.from_seed(5), device="encotrive")
+    before = tuple(read_tpdo(bench.drive(), slot) for slot in tpdo_slots(bench.drive().dictionary))
+    for loop in ("plant", "closed"):
+        with pytest.raises(NoRecorder, match=r"no communication cycle period \(0x1006\)"):
+            bench.measure(loop=loop, amplitude_pct=80, base_speed_rad_s=15, periods=4, position_window=200)
+    assert tuple(read_tpdo(bench.drive(), slot) for slot in tpdo_slots(bench.drive().dictionary)) == before
+    assert bench.drive().read("statusword").raw & 0x6F != 0x27  # never enabled

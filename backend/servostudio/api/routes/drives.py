@@ -71,24 +71,34 @@ def read_many(request: ReadMany, drive: NodeDrive) -> list[dict]:
 
 
 @router.get(
-    "/state", response_model=DriveState, summary="CiA 402 state and NMT state", dependencies=[Requires(Level.OPERATOR)]
+    "/state",
+    response_model=DriveState,
+    response_model_exclude_unset=True,
+    summary="CiA 402 state and NMT state",
+    dependencies=[Requires(Level.OPERATOR)],
 )
 def get_state(connection: OpenBus, drive: NodeDrive) -> dict:
     """The NMT state as the node's heartbeat or boot-up said it; without one, the status word just read over SDO
     proves it pre-operational or operational (``nmt_source: sdo``)."""
-    state = device_control.drive_state(connection, drive)
-    return {**state, **known_nmt_state(connection.nmt_state(drive.node), answered_sdo=True)}
+    return _with_nmt(connection, drive, device_control.drive_state(connection, drive))
 
 
 @router.put(
     "/state",
     response_model=DriveState,
     summary="Walk the CiA 402 state machine to a target state",
+    response_model_exclude_unset=True,
     dependencies=[Requires(Level.MAINTENANCE)],
 )
 def put_state(request: StateRequest, connection: OpenBus, drive: NodeDrive, motion: Motion) -> dict:
     """Enabling (operation-enabled) needs the axis armed by the caller's live client (X-Servo-Client)."""
-    state = device_control.change_state(connection, motion, drive, request.target)
+    return _with_nmt(connection, drive, device_control.change_state(connection, motion, drive, request.target))
+
+
+def _with_nmt(connection: OpenBus, drive: NodeDrive, state: dict) -> dict:
+    """A CANopen node's state with what is known of its NMT state; a PROFIBUS-DP drive has no NMT: left out."""
+    if not drive.profile.canopen:
+        return state
     return {**state, **known_nmt_state(connection.nmt_state(drive.node), answered_sdo=True)}
 
 

@@ -51,6 +51,7 @@ class TtaProClient:
         self._link_error: ServoStudioError | None = None
         self._sent = 0  # output images composed so far
         self._answered = 0  # the output image the latest input image answered
+        self._on_status: Callable[[int], None] | None = None
         self.exchange: DataExchange = master.exchange(
             address, ppo, self._output_image, self._input_image, self._on_link, period, watchdog
         )
@@ -63,6 +64,11 @@ class TtaProClient:
         self.exchange.stop()
 
     # -- process data -----------------------------------------------------------------------------------------
+
+    def on_status_word(self, listener: Callable[[int], None]) -> None:
+        """Call ``listener(status_word)`` on the exchange's thread whenever the status word (PZD1 in) changes; it
+        must not block (an event hub's publish)."""
+        self._on_status = listener
 
     @property
     def status_word(self) -> int:
@@ -155,6 +161,7 @@ class TtaProClient:
     def _input_image(self, data: bytes) -> None:
         reply = PkwMessage.decode(data[:PKW_BYTES])
         with self._condition:
+            previous = self._inputs[0] if self._answered else None
             self._inputs = unpack_words(data[self.ppo.pzd_offset :])
             self._answered = self._sent
             self._condition.notify_all()
@@ -162,6 +169,9 @@ class TtaProClient:
             if completed is not None:
                 self._reply = completed
                 self._condition.notify_all()
+            status, listener = self._inputs[0], self._on_status
+        if listener is not None and status != previous:  # outside the lock: the listener publishes an event
+            listener(status)
 
     def _on_link(self, error: ServoStudioError | None) -> None:
         with self._condition:

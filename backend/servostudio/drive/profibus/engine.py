@@ -24,6 +24,7 @@ unchanged.
 
 from __future__ import annotations
 
+import functools
 import threading
 import time
 from collections import deque
@@ -38,10 +39,11 @@ from servostudio.drive.profibus.link import ProfibusLink, refusal
 from servostudio.drive.profibus.pkw import read_request, write_request
 from servostudio.drive.profibus.pkw_errors import PkwError, PkwRefused
 from servostudio.drive.profibus.pkw_handshake import reply_value
+from servostudio.drive.profibus.pzd import join_double, split_double
 from servostudio.drive.sdo import SdoAbortError, SdoEngine, SdoError, SdoLinkError, SdoTimeoutError, TransferBatch
 from servostudio.errors import InvalidInput, ServoStudioError, Timeout
 from servostudio.od.datatypes import DataType
-from servostudio.od.pnu_model import CONTROL_WORD, STATUS_WORD, Parameter, ParameterDictionary
+from servostudio.od.pnu_model import CONTROL_WORD, POSITION_SET_POINT, STATUS_WORD, Parameter, ParameterDictionary
 
 R = Any
 T = TypeVar("T")
@@ -130,6 +132,8 @@ class _Transfer:
 
 
 ParameterLists = Callable[[int], ParameterDictionary | None]
+StatusListener = Callable[[int, int], None]
+"""(node, status word)."""
 
 
 class PkwEngine(SdoEngine):
@@ -142,7 +146,17 @@ class PkwEngine(SdoEngine):
         self._clients: dict[int, TtaProClient] = {}
         self._workers: dict[int, _NodeWorker] = {}
         self._guard = threading.Lock()
+        self._status_listener: StatusListener | None = None
         link.on_state(self._closed_with_link)
+
+    def on_status_word(self, listener: StatusListener) -> None:
+        """Call ``listener(node, status_word)`` whenever a station in data exchange sends a new PZD1 status word
+        (the bus's drive_state events: a PROFIBUS line has no CAN frames for a bus monitor to watch)."""
+        with self._guard:
+            self._status_listener = listener
+            clients = list(self._clients.items())
+        for node, client in clients:
+            client.on_status_word(functools.partial(listener, node))
 
     # -- the SDO engine's interface ------------------------------------------------------------------------------
     def upload(
@@ -274,7 +288,11 @@ class PkwEngine(SdoEngine):
         with self._guard:
             client = self._clients.get(node)
         if client is None:
-            client = TtaProClient(self.profibus.master, node).start()
+            client = TtaProClient(self.profibus.master, node)
+            listener = self._status_listener
+            if listener is not None:
+                client.on_status_word(functools.partial(listener, node))
+            client.start()
             with self._guard:
                 self._clients[node] = client
         return client
@@ -296,11 +314,15 @@ class PkwEngine(SdoEngine):
             client.close()
 
 
-PROCESS_DATA = (CONTROL_WORD, STATUS_WORD)
+PROCESS_DATA = (CONTROL_WORD, STATUS_WORD, POSITION_SET_POINT)
+SET_POINT_WORDS = (4, 5)
+"""PZD5 (most significant word) and PZD6 of the PPO write: the position set point (``POSITION_SET_POINT``)."""
 
 
 def _process_data(client: TtaProClient, transfer: _Transfer) -> bytes | None:
-    """PZD1: the status word in, the control word out (read back as it goes out)."""
+    """PZD1: the status word in, the control word out (read back as it goes out); PZD5-6: the position set point."""
+    if transfer.pnu == POSITION_SET_POINT:
+        return _set_point(client, transfer)
     if transfer.pnu == STATUS_WORD:
         if transfer.data is not None:
             raise ValueError("the status word is the drive's: it cannot be written")
@@ -308,6 +330,18 @@ def _process_data(client: TtaProClient, transfer: _Transfer) -> bytes | None:
     if transfer.data is None:
         return client.output(0).to_bytes(2, "little")
     client.send_output(0, int.from_bytes(transfer.data, "little"), transfer.timeout)
+    return None
+
+
+def _set_point(client: TtaProClient, transfer: _Transfer) -> bytes | None:
+    """Both words go out in the images after the call; it returns once a Data_Exchange carried the second (a move
+    is triggered only after that, so the drive never starts on half a set point)."""
+    high, low = SET_POINT_WORDS
+    if transfer.data is None:
+        return join_double(client.output(high), client.output(low)).to_bytes(4, "little", signed=True)
+    upper, lower = split_double(int.from_bytes(transfer.data, "little", signed=True))
+    client.set_output(high, upper)
+    client.send_output(low, lower, transfer.timeout)
     return None
 
 

@@ -119,6 +119,24 @@ class Addressing:
     redirect_offset: int | None = None
 
 
+@dataclass(frozen=True)
+class ManualMotions:
+    """Moves and homing started by control-word edges instead of CiA 402 profile position and homing mode (the
+    TTA-PRO's CW12 / CW13 toggles and CW11 rising edge, docs/profibus.md §12): the bits, and the objects (semantic
+    names) of the target, the speed in rpm and the homing configuration the homing "method" is written to."""
+
+    absolute: int
+    relative: int
+    homing: int
+    #: status bits: toggles when the drive takes a command; the position reached; the home found
+    acknowledge: int
+    position_reached: int
+    home_found: int
+    target: str = "target_position"
+    speed: str = "profile_velocity"
+    homing_configuration: str = "homing_configuration"
+
+
 class ProfileError(NotFound, KeyError):
     """The device has no object or signature of that semantic name."""
 
@@ -166,6 +184,10 @@ class DeviceProfile:
     parameter_files: Mapping[str, SaveType] = field(default_factory=lambda: {"DRIVEPAR.TXT": SaveType.DRIVEPAR})
     #: the sequence file is read through the sequence objects (XtrapulsPac)
     has_sequences: bool = False
+    #: objects (semantic names) a restore writes before the rest of a file, in this order: those the others are
+    #: scaled by or depend on (the TTA-PRO's maximum speed, position resolution and feedback selection); the rest
+    #: follow in the file's order
+    restore_first: tuple[str, ...] = ()
     addressing: Addressing = Addressing()
     #: objects (semantic names) that set the axis moving or change how it moves: the controller's alone
     motion_objects: frozenset[str] = CIA402_MOTION_OBJECTS
@@ -202,6 +224,8 @@ class DeviceProfile:
     #: control-word bits that jog the axis + and − at ``jog_speed`` rpm while set (the TTA-PRO's CW8 / CW9); None:
     #: the quick test jogs in CiA 402 profile velocity (``services.motion.jog``)
     jog_bits: tuple[int, int] | None = None
+    #: moves and homing by control-word edges (the TTA-PRO's); None: CiA 402 profile position and homing mode
+    manual_motions: ManualMotions | None = None
 
     @property
     def canopen(self) -> bool:

@@ -13,8 +13,8 @@ engine carries them through PZD. Their bits 0-3 and 7 (status bits 0-6) are CiA 
 
 from __future__ import annotations
 
-from servostudio.drive.profibus.pzd import ControlBit
-from servostudio.drive.profiles.base import Addressing, DeviceProfile
+from servostudio.drive.profibus.pzd import ControlBit, StatusBit
+from servostudio.drive.profiles.base import Addressing, DeviceProfile, ManualMotions
 from servostudio.drive.profiles.ttapro_faults import (
     ERRORS,
     POSITIONER_ERRORS_FIRST,
@@ -22,8 +22,9 @@ from servostudio.drive.profiles.ttapro_faults import (
     POWER_STAGE_FIRST,
     WARNINGS,
 )
+from servostudio.drive.profiles.ttapro_homing import HOMING_CONFIGURATIONS
 from servostudio.od.model import SaveType
-from servostudio.od.pnu_model import CONTROL_WORD, STATUS_WORD
+from servostudio.od.pnu_model import CONTROL_WORD, POSITION_SET_POINT, STATUS_WORD
 
 PROFIBUS_DP = "PROFIBUS-DP"
 QUICK_STOP = 0x0002
@@ -73,6 +74,7 @@ _OBJECTS: dict[str, tuple[int, int]] = {
     "speed_gain_scaling": (832, 0),
     # position
     "position_resolution": (740, 0),
+    "encoder_increments": (870, 0),  # the resolution in its double form: position units per revolution
     "following_error_window": (741, 0),
     "positioner_configuration": (742, 0),
     "software_position_limit_max": (747, 0),
@@ -89,6 +91,12 @@ _OBJECTS: dict[str, tuple[int, int]] = {
     "target_position": (767, 0),
     "home_offset": (768, 0),
     "position_actual": (774, 0),
+    # feedback (PNU 894 programs the motor feedback from them)
+    "encoder_input_selection": (890, 0),
+    "encoder_input_resolution": (891, 0),
+    "encoder_interpolation": (892, 0),
+    "motor_feedback_selection": (893, 0),
+    "sincos_feedback_tracks": (898, 0),
     # monitors, versions, faults
     "drive_error_code": (755, 0),
     "digital_inputs": (769, 0),
@@ -103,7 +111,32 @@ _OBJECTS: dict[str, tuple[int, int]] = {
     # process data (PZD1), not PNUs
     "controlword": (CONTROL_WORD, 0),
     "statusword": (STATUS_WORD, 0),
+    "position_set_point": (POSITION_SET_POINT, 0),  # PZD5-6: replaces PNU 767 every cycle
 }
+
+RESTORE_FIRST = (
+    "max_motor_speed",
+    "position_resolution",
+    "encoder_increments",
+    "encoder_input_selection",
+    "encoder_input_resolution",
+    "encoder_interpolation",
+    "motor_feedback_selection",
+    "sincos_feedback_tracks",
+)
+"""What a TTAPAR.TXT restore writes first: speeds are stored as % of 721, positions count in 740/870's units."""
+
+#: the quick test's moves and homing: CW12 / CW13 toggled (to the PZD5-6 set point at PNU 760 rpm), CW11 rising
+#: (PNU 766's configuration); ZSW12 toggles when the drive takes one, ZSW10 position reached, ZSW11 home found
+MANUAL_MOTIONS = ManualMotions(
+    absolute=ControlBit.ABSOLUTE_MOVE,
+    relative=ControlBit.RELATIVE_MOVE,
+    homing=ControlBit.HOMING,
+    acknowledge=StatusBit.ACKNOWLEDGE,
+    position_reached=StatusBit.POSITION_REACHED,
+    home_found=StatusBit.HOME_FOUND,
+    target="position_set_point",
+)
 
 TTAPRO = DeviceProfile(
     device="ttapro",
@@ -111,15 +144,32 @@ TTAPRO = DeviceProfile(
     #: PNU 729 is a procedure: writing it saves every E parameter (the drive refuses it while enabled, error 17)
     procedure_values={"save": ("save_parameters", 1)},
     parameter_files={PARAMETER_FILE: SaveType.DRIVEPAR},
+    #: the manual's restore order (L467-480 of the extraction, §5.2): 721 and 740/870 before what is scaled by them,
+    #: the feedback selection 890-893/898 before the rest; the save (729) at the end, with the drive disabled
+    restore_first=RESTORE_FIRST,
+    save_needs_disabled=True,
     addressing=Addressing(node_ids=range(1, 126), reason="PROFIBUS-DP station addresses are 1-125"),
     #: what moves the axis or changes how it moves: the PZD control word (the guard judges it through the CiA 402
     #: transitions: its bits 0-3 and 7 are CiA 402's), the jog speed, and the writes that turn the motor or free the
     #: axis by themselves: the auto-phasing and auto-tuning procedures, the manual brake release (a vertical axis falls)
-    motion_objects=frozenset({"controlword", "auto_phasing", "auto_tuning", "manual_brake", "jog_speed"}),
+    motion_objects=frozenset(
+        {
+            "controlword",
+            "position_set_point",
+            "auto_phasing",
+            "auto_tuning",
+            "manual_brake",
+            "jog_speed",
+            "profile_velocity",
+            "homing_configuration",
+        }
+    ),
     fieldbus=PROFIBUS_DP,
     controlword_fixed=ControlBit.PROFIBUS_CONTROL | ControlBit.NO_STOP | ControlBit.NO_INTERMEDIATE_STOP,
     #: the quick test's jog: CW8 / CW9 at the jog speed (PNU 763, rpm) while the bit stays set
     jog_bits=(ControlBit.JOG_PLUS, ControlBit.JOG_MINUS),
+    manual_motions=MANUAL_MOTIONS,
+    homing_methods=HOMING_CONFIGURATIONS,
     controlword_commands={QUICK_STOP: ControlBit.ON | ControlBit.NO_OFF2},
     #: faults polled (no EMCY): PNU 773 and 778 with the manual's texts, warnings PNU 873 (``ttapro_faults``)
     error_words=(("positioner_error_code", POSITIONER_ERRORS_FIRST), ("power_stage_fault_code", POWER_STAGE_FIRST)),

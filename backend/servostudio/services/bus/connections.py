@@ -17,7 +17,7 @@ import can
 
 from servostudio.drive.access import OPEN_GATE, Drive, WriteGate
 from servostudio.drive.link import BusLink
-from servostudio.drive.monitor import BusMonitor
+from servostudio.drive.monitor import BusMonitor, DriveStateReporter
 from servostudio.drive.nmt import NmtCommand, NmtHeard, guard_nmt, send_nmt
 from servostudio.drive.profibus.engine import PkwEngine
 from servostudio.drive.profibus.link import ProfibusLink, refusal
@@ -123,6 +123,8 @@ class BusConnection:
     simulation: Simulation | None = None  # the simulated drives of a ``sim`` bus, stopped with it
     gate: WriteGate = OPEN_GATE  # every write of the bus's drives passes it: the manager's motion guard
     monitor: BusMonitor | None = None
+    #: a bus without CAN frames (PROFIBUS-DP): its drive_state events from the status words its engine receives
+    drive_states: DriveStateReporter | None = None
     share: BusShare | None = None  # its socketcand endpoint for the user's own scripts, when shared
     motion: MotionGuard | None = None  # judges and logs its NMT commands (the manager's guard)
     #: the nodes and the SYNC its running jobs hold (captures, rolls, frequency responses, identifications)
@@ -188,8 +190,9 @@ class BusConnection:
 
     def report_statusword(self, node: int, statusword: int) -> None:
         """Publish a drive_state event when a status word read elsewhere shows a state change."""
-        if self.monitor is not None:
-            self.monitor.report_statusword(node, statusword)
+        reporter = self.monitor or self.drive_states
+        if reporter is not None:
+            reporter.report_statusword(node, statusword)
 
     def nmt_state(self, node: int) -> str | None:
         """The node's NMT state as its last heartbeat or boot-up said (None before any)."""
@@ -289,20 +292,24 @@ class ConnectionManager:
 
     def _open_profibus(self, spec: BusSpec, bus_id: str) -> BusConnection:
         """A PROFIBUS-DP line (docs/profibus.md §9): its drives are ordinary `Drive`s on their parameter list with
-        the PKW engine in place of the SDO engine; no bus monitor (no CAN frames to watch). The master is the line's
+        the PKW engine in place of the SDO engine; no bus monitor (no CAN frames to watch), but drive_state events from
+        the PZD status word of every station in data exchange (``PkwEngine.on_status_word``). The master is the line's
         (`open_dp_line`: pyprofibus for a serial device, the project's own for a TCP stream). A line that cannot be
         opened is refused at once (`DpLinkError`, 503): there is no interface to wait for."""
         link = ProfibusLink(bus_id, open_dp_line(spec))
+        engine = PkwEngine(link, lambda node: parameter_list(self.library, connection.nodes.get(node)))
         connection = BusConnection(
             bus_id,
             spec,
             link,
-            PkwEngine(link, lambda node: parameter_list(self.library, connection.nodes.get(node))),
+            engine,
             self.library,
             self.events,
             gate=self.motion.gate(bus_id),
             motion=self.motion,
         )
+        connection.drive_states = DriveStateReporter(bus_id, self.events.publish)
+        engine.on_status_word(connection.drive_states.report_statusword)
         with self._lock:
             self._buses[bus_id] = connection
         link.start()

@@ -5,7 +5,10 @@ markers.ts, docs/what-if.md § Markers), so a saved result and the page agree:
 - phase margin 180° + ∠L at |L| = 1, gain margin −20·log|L| at ∠L = −180° (phase unwrapped), of the open loop L;
 - resonance / anti-resonance: the strongest peak / dip, at least 3 dB prominent, of the plant's magnitude
   + 20·log10 f (flat for a rigid plant);
-- crossings interpolated linearly in dB or degrees over log-frequency.
+- crossings interpolated linearly in dB or degrees over log-frequency;
+- only coherent points count (γ² ≥ ``MIN_COHERENCE``, docs/frequency-response.md §6): the others are dropped before
+  anything is marked, so they neither make nor move a marker, a peak stands out of its coherent neighbours, and a
+  marker with no coherent points to stand on is None.
 
 A closed-loop measurement gives the bandwidth, and the margins of ``L = T / (1 − T)`` (T the measured closed loop:
 exact for a loop whose reference and feedback pass the same controller, i.e. KCv = KDv = 0 and the speed filter
@@ -21,7 +24,11 @@ from collections.abc import Mapping, Sequence
 
 HALF_POWER_DB = -10.0 * math.log10(2.0)
 PROMINENCE_DB = 3.0
+#: at or above the 95 % noise floor of γ² for every allowed number of periods (2 … 32), and a point's random magnitude
+#: error then ≤ 0.7 dB at 4 periods (docs/frequency-response.md §6)
+MIN_COHERENCE = 0.95
 Points = Sequence[Mapping[str, float]]
+FIELDS = ("freq_hz", "magnitude_db", "phase_deg")
 
 
 def crossing_down(freq: Sequence[float], values: Sequence[float], level: float) -> float | None:
@@ -69,7 +76,7 @@ def markers_of(loop: str, points: Points) -> dict[str, float | None]:
     result: dict[str, float | None] = dict.fromkeys(
         ("bandwidth_hz", "gain_margin_db", "phase_margin_deg", "resonance_hz", "antiresonance_hz")
     )
-    usable = [point for point in points if math.isfinite(point["magnitude_db"]) and point["freq_hz"] > 0]
+    usable = coherent(points)
     if len(usable) < 2:
         return result
     freq = [point["freq_hz"] for point in usable]
@@ -80,6 +87,20 @@ def markers_of(loop: str, points: Points) -> dict[str, float | None]:
     open_db, open_phase = _open_loop(usable)
     result.update(margins(freq, open_db, _branch(freq, open_db, open_phase)))
     return result
+
+
+def coherent(points: Points) -> list[Mapping[str, float]]:
+    """The points a marker may stand on: finite, at a positive frequency, γ² ≥ ``MIN_COHERENCE`` (a coherence that
+    is missing or not finite — not estimated — supports nothing)."""
+    return [point for point in points if _finite(point) and point["freq_hz"] > 0 and _coherent(point.get("coherence"))]
+
+
+def _finite(point: Mapping[str, float]) -> bool:
+    return all(isinstance(point.get(key), int | float) and math.isfinite(point[key]) for key in FIELDS)
+
+
+def _coherent(coherence: float | None) -> bool:
+    return isinstance(coherence, int | float) and math.isfinite(coherence) and coherence >= MIN_COHERENCE
 
 
 def _branch(freq: Sequence[float], open_db: Sequence[float], phases: list[float]) -> list[float]:

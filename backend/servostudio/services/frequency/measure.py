@@ -25,6 +25,7 @@ from servostudio.drive.access import Drive
 from servostudio.drive.cia402 import State
 from servostudio.drive.control import set_state
 from servostudio.drive.link import BusLink
+from servostudio.drive.sync import CYCLE_PERIOD
 from servostudio.errors import InvalidInput, ServoStudioError
 from servostudio.services.cancel import Cancellation, Cancelled
 from servostudio.services.frequency import estimate, markers, tpdo_source
@@ -135,9 +136,21 @@ def check_request(drive: Drive, request: MeasureRequest, bitrate: int | None = N
     return design(request.from_hz, request.to_hz, request.points, SYNC_PERIOD_S, tilt, MONITOR_PATTERN)
 
 
+def _follows_sync(drive: Drive) -> bool:
+    """A drive that can be told the SYNC period (0x1006) locks its control cycle to the SYNC (CiA 301)."""
+    return drive.dictionary is not None and drive.dictionary.get(*CYCLE_PERIOD) is not None
+
+
 def _response_plan(drive: Drive, request: MeasureRequest, bitrate: int | None) -> ResponsePlan:
     """The TPDO response's plan, or the refusal: a plant needs the current actual value, and the bus the SYNC
     rate's frames."""
+    if not _follows_sync(drive):
+        raise NoRecorder(
+            f"node {drive.node}: the {drive.profile.device} has no recorder and no communication cycle period "
+            "(0x1006): its control cycle does not follow the SYNC, so its TPDO answers are not samples at known "
+            "instants (the host's SYNC jitter, a fraction of a millisecond, is tens of degrees at 100 Hz); a "
+            "frequency response needs the drive's recorder or a drive that locks its cycle to the SYNC"
+        )
     current = _present(drive, "current_actual")
     if request.loop == "plant" and not current:
         raise NoRecorder(

@@ -22,6 +22,7 @@ from typing import TYPE_CHECKING
 from servostudio.drive.access import Drive
 from servostudio.drive.cia402 import State
 from servostudio.drive.control import read_state, set_state
+from servostudio.drive.profiles.base import ManualMotions
 from servostudio.errors import Conflict, InvalidInput, ServoStudioError
 from servostudio.services.audit import Actor
 from servostudio.services.motion.control import Axis, where
@@ -141,14 +142,10 @@ class Motions:
         target = round(distance)
         travel = target - int(drive.read("position_actual").raw) if absolute else target
         limits.check_distance(axis, travel / per_revolution)
-        writes = [
-            ("modes_of_operation", PROFILE_POSITION),
-            ("profile_velocity", rpm_to_speed(drive, speed)),
-            ("target_position", target),
-        ]
+        writes, trigger, finished = _move_steps(drive, target, absolute, speed)
         request = {"distance": distance, "absolute": absolute, "velocity": speed}
         run = self._begin(actor, axis, drive, "move", hold, request)
-        return self._launch(run, writes, _set_point(0 if absolute else RELATIVE), _position_finished)
+        return self._launch(run, writes, trigger, finished)
 
     def home(
         self, actor: Actor, axis: Axis, drive: Drive, method: int, hold: bool, velocity: float | None = None
@@ -159,13 +156,11 @@ class Motions:
         if method not in methods:
             known = ", ".join(str(number) for number in sorted(methods))
             raise InvalidInput(f"{drive.profile.device} has no homing method {method}; it has {known}")
-        writes: list[tuple[str, int]] = [("modes_of_operation", HOMING), ("homing_method", method)]
         if velocity is not None:
             self.limits.of(axis).check_velocity(axis, velocity)
-            fast = max(1, rpm_to_speed(drive, abs(velocity)))
-            writes += [("homing_speed_fast", fast), ("homing_speed_slow", max(1, fast // 4))]
+        writes, trigger, finished = _homing_steps(drive, method, velocity)
         run = self._begin(actor, axis, drive, "home", hold, {"method": method, "velocity": velocity})
-        return self._launch(run, writes, _set_point(0), _homing_finished)
+        return self._launch(run, writes, trigger, finished)
 
     # ---- stop, keepalive, what runs ---------------------------------------------------------------------------
 
@@ -344,6 +339,66 @@ def _end_jog(drive: Drive) -> None:
         drive.write("target_velocity", 0)
     else:
         drive.write("controlword", _jog_word(drive))
+
+
+Writes = list[tuple[str, int]]
+Steps = tuple[Writes, Callable[[Drive], None], Finished]
+
+
+def _move_steps(drive: Drive, target: int, absolute: bool, rpm: float) -> Steps:
+    """What a move writes, what triggers it, when it is over. CiA 402: profile position, a new set-point. A drive
+    with manual motions (the TTA-PRO): its set point and speed in rpm, then a toggle of the move's control bit."""
+    manual = drive.profile.manual_motions
+    if manual is None:
+        writes = [
+            ("modes_of_operation", PROFILE_POSITION),
+            ("profile_velocity", rpm_to_speed(drive, rpm)),
+            ("target_position", target),
+        ]
+        return writes, _set_point(0 if absolute else RELATIVE), _position_finished
+    writes = [(manual.speed, max(1, round(rpm))), (manual.target, target)]
+    bit = manual.absolute if absolute else manual.relative
+    return writes, _manual_command(manual, bit, toggle=True), _manual_done(manual.position_reached)
+
+
+def _homing_steps(drive: Drive, method: int, rpm: float | None) -> Steps:
+    """CiA 402: homing mode with the method (0x6098), its speeds (slow: a quarter). Manual motions: the method is
+    the homing configuration (TTA-PRO: PNU 766), at the manual-motion speed in rpm, started by a rising edge."""
+    manual = drive.profile.manual_motions
+    if manual is None:
+        writes: Writes = [("modes_of_operation", HOMING), ("homing_method", method)]
+        if rpm is not None:
+            fast = max(1, rpm_to_speed(drive, abs(rpm)))
+            writes += [("homing_speed_fast", fast), ("homing_speed_slow", max(1, fast // 4))]
+        return writes, _set_point(0), _homing_finished
+    writes = [(manual.homing_configuration, method)]
+    if rpm is not None:
+        writes.append((manual.speed, max(1, round(abs(rpm)))))
+    return writes, _manual_command(manual, manual.homing, toggle=False), _manual_done(manual.home_found)
+
+
+def _manual_command(manual: ManualMotions, bit: int, toggle: bool) -> Callable[[Drive], None]:
+    """An edge of ``bit`` (a toggle, or a rising edge: cleared first when set), held until the drive acknowledges
+    it by toggling its acknowledge status bit; the motion's status is judged only after that."""
+
+    def trigger(drive: Drive) -> None:
+        before = int(drive.read("statusword").raw) & manual.acknowledge
+        word = int(drive.read("controlword").raw)
+        if not toggle and word & bit:
+            drive.write("controlword", word & ~bit)
+        drive.write("controlword", word ^ bit if toggle else word | bit)
+        _wait_for(drive, lambda statusword: statusword & manual.acknowledge != before, "acknowledge the command")
+
+    return trigger
+
+
+def _manual_done(status_bit: int) -> Finished:
+    """Done once the drive reports it (position reached, home found) after it acknowledged the command."""
+
+    def finished(statusword: int) -> tuple[str, str | None] | None:
+        return ("done", None) if statusword & status_bit else None
+
+    return finished
 
 
 def _set_point(bits: int) -> Callable[[Drive], None]:

@@ -122,8 +122,10 @@ export class DashboardModel {
     try {
       const answer = await driveApi.state(this.bus, this.node);
       live.updateAxis(this.bus, this.node, { online: true, nmt: answer.nmt_state });
-      // The node's own heartbeat state, else what its SDO answer proves (pre-operational or operational).
-      this.nmt.val = `NMT ${answer.nmt_text || (answer.nmt_state ?? "unknown")}`;
+      // The node's own heartbeat state, else what its SDO answer proves (pre-operational or operational); a
+      // PROFIBUS-DP drive has no NMT, and the server leaves the fields out.
+      const noNmt = answer.nmt_state === undefined && answer.nmt_text === undefined;
+      this.nmt.val = noNmt ? "no NMT (PROFIBUS-DP)" : `NMT ${answer.nmt_text || (answer.nmt_state ?? "unknown")}`;
       this.applyStatusword(answer.statusword);
     } catch (error) {
       live.updateAxis(this.bus, this.node, { online: false });

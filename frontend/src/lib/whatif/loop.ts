@@ -56,17 +56,21 @@ export interface BodePoint {
   freq_hz: number;
   magnitude_db: number;
   phase_deg: number;
-  coherence?: number;
+  /** γ² of a measured point; null when it was not estimated */
+  coherence?: number | null;
 }
 
-/** A frequency response: frequencies and complex values. */
+/** A frequency response: frequencies and complex values; a measured one (and what the model computes on it) carries
+ * each point's coherence, which the markers weigh (markers.ts). */
 export interface Response {
   freq: number[];
   value: Complex[];
+  coherence?: (number | null)[];
 }
 
 export function responseOf(points: BodePoint[]): Response {
-  return { freq: points.map((p) => p.freq_hz), value: points.map((p) => fromBode(p.magnitude_db, p.phase_deg)) };
+  const freq = points.map((p) => p.freq_hz), value = points.map((p) => fromBode(p.magnitude_db, p.phase_deg));
+  return points.some((p) => p.coherence !== undefined) ? { freq, value, coherence: points.map((p) => p.coherence ?? null) } : { freq, value };
 }
 
 const ONE = complex(1);
@@ -121,7 +125,8 @@ export function loopResponses(plant: Response, params: LoopParams): LoopResponse
     open.push(loop);
     closed.push(div(mul(forward, e.a), add(ONE, loop)));
   }
-  return { openLoop: { freq: plant.freq, value: open }, closedLoop: { freq: plant.freq, value: closed } };
+  const { freq, coherence } = plant;
+  return { openLoop: { freq, value: open, coherence }, closedLoop: { freq, value: closed, coherence } };
 }
 
 /** The filters of a loop that the plant measurement included (they are divided out, then the new ones applied). */
@@ -129,5 +134,5 @@ export function withoutFilters(plant: Response, filtersHz: number[], periodS: nu
   const params: LoopParams = {
     kp: 0, ki: 0, kiLeakHz: 0, kc: 0, kd: 0, kdFilterHz: 0, currentFiltersHz: filtersHz, speedFilterS: 0, periodS, kt: 1,
   };
-  return { freq: plant.freq, value: plant.value.map((value, n) => div(value, elements(params, plant.freq[n]).actuator)) };
+  return { ...plant, value: plant.value.map((value, n) => div(value, elements(params, plant.freq[n]).actuator)) };
 }

@@ -1,7 +1,8 @@
 /**
  * What the Bode page marks on a response: the closed loop's −3 dB bandwidth, the open loop's gain and phase
  * margins, the plant's resonance and anti-resonance (docs/what-if.md). Between two measured points the crossing is
- * interpolated linearly in dB (or degrees) over log-frequency.
+ * interpolated linearly in dB (or degrees) over log-frequency. Only coherent points count, as in the backend's
+ * services/frequency/markers.py (docs/frequency-response.md §6; both are run on tests/fixtures/markers.json).
  */
 
 import { abs, db, unwrapDeg } from "./complex";
@@ -13,6 +14,22 @@ export interface Markers {
   phase_margin_deg: number | null;
   resonance_hz: number | null;
   antiresonance_hz: number | null;
+}
+
+/** γ² a point needs to make or move a marker: at or above the 95 % noise floor of γ² for every allowed number of
+ * periods (2 … 32), and a point's random magnitude error is then ≤ 0.7 dB at 4 periods. */
+export const MIN_COHERENCE = 0.95;
+
+const isCoherent = (coherence: number | null | undefined): boolean =>
+  typeof coherence === "number" && Number.isFinite(coherence) && coherence >= MIN_COHERENCE;
+
+/** The points of a response a marker may stand on: γ² ≥ MIN_COHERENCE (a computed response, without coherence, is
+ * all coherent; a coherence not estimated supports nothing). The others neither make nor move a marker. */
+export function coherentPart(response: Response): Response {
+  const coherence = response.coherence;
+  if (!coherence) return response;
+  const keep = (_: unknown, n: number) => isCoherent(coherence[n]);
+  return { freq: response.freq.filter(keep), value: response.value.filter(keep), coherence: coherence.filter(keep) };
 }
 
 /** Log-frequency where `values` (one per frequency) first crosses `level` going down; null when it never does. */
@@ -41,12 +58,14 @@ function interpolate(freq: number[], values: number[], at: number): number {
 const HALF_POWER_DB = -10 * Math.log10(2);
 
 /** −3 dB bandwidth of a closed loop: where its magnitude first falls below 1/√2. */
-export function bandwidth(closed: Response): number | null {
+export function bandwidth(response: Response): number | null {
+  const closed = coherentPart(response);
   return crossingDown(closed.freq, closed.value.map(db), HALF_POWER_DB);
 }
 
 /** Phase margin at the gain crossover (|L| = 1) and gain margin at the phase crossover (∠L = −180°). */
-export function margins(open: Response): { gain_margin_db: number | null; phase_margin_deg: number | null } {
+export function margins(response: Response): { gain_margin_db: number | null; phase_margin_deg: number | null } {
+  const open = coherentPart(response);
   const magnitudes = open.value.map(db);
   const phases = unwrapDeg(open.value);
   const crossover = crossingDown(open.freq, magnitudes, 0);
@@ -75,7 +94,8 @@ function extremum(freq: number[], values: number[], sign: 1 | -1, prominence = 3
   return best;
 }
 
-export function resonances(plant: Response): { resonance_hz: number | null; antiresonance_hz: number | null } {
+export function resonances(response: Response): { resonance_hz: number | null; antiresonance_hz: number | null } {
+  const plant = coherentPart(response);
   const values = detrended(plant);
   return { resonance_hz: extremum(plant.freq, values, 1), antiresonance_hz: extremum(plant.freq, values, -1) };
 }
