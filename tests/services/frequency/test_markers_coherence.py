@@ -96,7 +96,7 @@ def build() -> list[dict]:
         ("two-mass plant, coherent resonance, an incoherent spike", "plant", noisy(plant_grid, two_mass, spike),
          {"resonance_hz": resonance, "antiresonance_hz": anti}),
         ("two-mass plant, every point incoherent", "plant",
-         noisy(plant_grid, two_mass, {n: (0.0, 0.8) for n in range(46)}), {}),
+         noisy(plant_grid, two_mass, {n: (0.0, 0.7) for n in range(46)}), {}),
         ("closed loop, incoherent points before the bandwidth", "closed", noisy(loop_grid, closed, near_crossover),
          truth),
         ("closed loop, every point incoherent", "closed", noisy(loop_grid, closed, incoherent), {}),
@@ -157,7 +157,7 @@ def with_incoherent(points: list[dict[str, float]], seed: int, count: int) -> li
     rng = random.Random(seed)
     extra = [
         {"freq_hz": rng.uniform(2.0, 1000.0), "magnitude_db": rng.uniform(-60.0, 80.0),
-         "phase_deg": rng.uniform(-400.0, 100.0), "coherence": rng.uniform(0.0, markers.MIN_COHERENCE * 0.999)}
+         "phase_deg": rng.uniform(-400.0, 100.0), "coherence": rng.uniform(0.0, markers.MIN_DIP_COHERENCE * 0.999)}
         for _ in range(count)
     ]  # fmt: skip
     return sorted([*points, *extra], key=lambda point: point["freq_hz"])

@@ -27,6 +27,9 @@ PROMINENCE_DB = 3.0
 #: at or above the 95 % noise floor of γ² for every allowed number of periods (2 … 32), and a point's random magnitude
 #: error then ≤ 0.7 dB at 4 periods (docs/frequency-response.md §6)
 MIN_COHERENCE = 0.95
+#: an anti-resonance is where the shaft hardly moves: its dip has a small output and, by nature, a lower γ² (0.92 at
+#: rest, less on a loaded host, for 0.99 beside it); 0.8 is still above the 95 % noise floor for 4 periods (0.63)
+MIN_DIP_COHERENCE = 0.8
 Points = Sequence[Mapping[str, float]]
 FIELDS = ("freq_hz", "magnitude_db", "phase_deg")
 
@@ -81,7 +84,10 @@ def markers_of(loop: str, points: Points) -> dict[str, float | None]:
         return result
     freq = [point["freq_hz"] for point in usable]
     if loop == "plant":
-        result.update(resonances(freq, [point["magnitude_db"] for point in usable]))
+        dips = coherent(points, MIN_DIP_COHERENCE)
+        result["resonance_hz"] = resonances(freq, [point["magnitude_db"] for point in usable])["resonance_hz"]
+        dip_freq, dip_db = [point["freq_hz"] for point in dips], [point["magnitude_db"] for point in dips]
+        result["antiresonance_hz"] = resonances(dip_freq, dip_db)["antiresonance_hz"]
         return result
     result["bandwidth_hz"] = bandwidth(freq, [point["magnitude_db"] for point in usable])
     open_db, open_phase = _open_loop(usable)
@@ -89,18 +95,19 @@ def markers_of(loop: str, points: Points) -> dict[str, float | None]:
     return result
 
 
-def coherent(points: Points) -> list[Mapping[str, float]]:
-    """The points a marker may stand on: finite, at a positive frequency, γ² ≥ ``MIN_COHERENCE`` (a coherence that
-    is missing or not finite — not estimated — supports nothing)."""
-    return [point for point in points if _finite(point) and point["freq_hz"] > 0 and _coherent(point.get("coherence"))]
+def coherent(points: Points, threshold: float = MIN_COHERENCE) -> list[Mapping[str, float]]:
+    """The points a marker may stand on: finite, at a positive frequency, γ² ≥ ``threshold`` (a coherence that is
+    missing or not finite — not estimated — supports nothing)."""
+    return [point for point in points
+            if _finite(point) and point["freq_hz"] > 0 and _coherent(point.get("coherence"), threshold)]  # fmt: skip
 
 
 def _finite(point: Mapping[str, float]) -> bool:
     return all(isinstance(point.get(key), int | float) and math.isfinite(point[key]) for key in FIELDS)
 
 
-def _coherent(coherence: float | None) -> bool:
-    return isinstance(coherence, int | float) and math.isfinite(coherence) and coherence >= MIN_COHERENCE
+def _coherent(coherence: float | None, threshold: float) -> bool:
+    return isinstance(coherence, int | float) and math.isfinite(coherence) and coherence >= threshold
 
 
 def _branch(freq: Sequence[float], open_db: Sequence[float], phases: list[float]) -> list[float]:

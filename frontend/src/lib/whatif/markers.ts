@@ -19,16 +19,18 @@ export interface Markers {
 /** γ² a point needs to make or move a marker: at or above the 95 % noise floor of γ² for every allowed number of
  * periods (2 … 32), and a point's random magnitude error is then ≤ 0.7 dB at 4 periods. */
 export const MIN_COHERENCE = 0.95;
+/** An anti-resonance's dip has a small output and, by nature, a lower γ² (markers.py MIN_DIP_COHERENCE). */
+export const MIN_DIP_COHERENCE = 0.8;
 
-const isCoherent = (coherence: number | null | undefined): boolean =>
-  typeof coherence === "number" && Number.isFinite(coherence) && coherence >= MIN_COHERENCE;
+const isCoherent = (coherence: number | null | undefined, threshold: number): boolean =>
+  typeof coherence === "number" && Number.isFinite(coherence) && coherence >= threshold;
 
 /** The points of a response a marker may stand on: γ² ≥ MIN_COHERENCE (a computed response, without coherence, is
  * all coherent; a coherence not estimated supports nothing). The others neither make nor move a marker. */
-export function coherentPart(response: Response): Response {
+export function coherentPart(response: Response, threshold = MIN_COHERENCE): Response {
   const coherence = response.coherence;
   if (!coherence) return response;
-  const keep = (_: unknown, n: number) => isCoherent(coherence[n]);
+  const keep = (_: unknown, n: number) => isCoherent(coherence[n], threshold);
   return { freq: response.freq.filter(keep), value: response.value.filter(keep), coherence: coherence.filter(keep) };
 }
 
@@ -96,8 +98,9 @@ function extremum(freq: number[], values: number[], sign: 1 | -1, prominence = 3
 
 export function resonances(response: Response): { resonance_hz: number | null; antiresonance_hz: number | null } {
   const plant = coherentPart(response);
-  const values = detrended(plant);
-  return { resonance_hz: extremum(plant.freq, values, 1), antiresonance_hz: extremum(plant.freq, values, -1) };
+  if (plant.freq.length < 2) return { resonance_hz: null, antiresonance_hz: null };
+  const dips = coherentPart(response, MIN_DIP_COHERENCE);
+  return { resonance_hz: extremum(plant.freq, detrended(plant), 1), antiresonance_hz: extremum(dips.freq, detrended(dips), -1) };
 }
 
 /** Every marker of a set of responses (the plant may be absent: a closed-loop measurement). */
