@@ -87,6 +87,8 @@ def build() -> list[dict]:
     top = {n: (gain, 0.6 + 0.05 * k) for k, (n, gain) in enumerate(((40, 5.0), (42, 7.0), (43, -6.0), (45, 4.0)))}
     anti, resonance = math.sqrt(K / JL) / TWO_PI, math.sqrt(K * (JM + JL) / (JM * JL)) / TWO_PI
     spike = {plant_grid.index(min(plant_grid, key=lambda f: abs(f - 250.0))): (12.0, 0.5)}
+    # dips the noise of a loaded host digs among the top points (γ² between the dip and the marker thresholds)
+    top_dips = {40: (-5.0, 0.86), 43: (-7.0, 0.9)}
     truth = loop_truth()
     near_bandwidth = min(range(len(loop_grid)), key=lambda n: abs(loop_grid[n] - 0.6 * truth["bandwidth_hz"]))
     near_crossover = {near_bandwidth: (-12.0, 0.3), near_bandwidth + 1: (8.0, 0.8)}
@@ -95,6 +97,9 @@ def build() -> list[dict]:
         ("rigid plant, incoherent noise at the top", "plant", noisy(plant_grid, rigid, top), {}),
         ("two-mass plant, coherent resonance, an incoherent spike", "plant", noisy(plant_grid, two_mass, spike),
          {"resonance_hz": resonance, "antiresonance_hz": anti}),
+        ("rigid plant, dips of γ² 0.86-0.9 at the top", "plant", noisy(plant_grid, rigid, top_dips), {}),
+        ("two-mass plant, a deeper dip of γ² 0.86-0.9 above the resonance", "plant",
+         noisy(plant_grid, two_mass, top_dips), {"resonance_hz": resonance, "antiresonance_hz": anti}),
         ("two-mass plant, every point incoherent", "plant",
          noisy(plant_grid, two_mass, {n: (0.0, 0.7) for n in range(46)}), {}),
         ("closed loop, incoherent points before the bandwidth", "closed", noisy(loop_grid, closed, near_crossover),

@@ -4,7 +4,8 @@ markers.ts, docs/what-if.md § Markers), so a saved result and the page agree:
 - bandwidth: the first frequency where the closed loop's magnitude falls below 1/√2 (−3.01 dB);
 - phase margin 180° + ∠L at |L| = 1, gain margin −20·log|L| at ∠L = −180° (phase unwrapped), of the open loop L;
 - resonance / anti-resonance: the strongest peak / dip, at least 3 dB prominent, of the plant's magnitude
-  + 20·log10 f (flat for a rigid plant);
+  + 20·log10 f (flat for a rigid plant); the anti-resonance only below the resonance (measured on the motor, a
+  two-mass plant's zero pair lies below its pole pair), so a lone dip is never one;
 - crossings interpolated linearly in dB or degrees over log-frequency;
 - only coherent points count (γ² ≥ ``MIN_COHERENCE``, docs/frequency-response.md §6): the others are dropped before
   anything is marked, so they neither make nor move a marker, a peak stands out of its coherent neighbours, and a
@@ -84,15 +85,23 @@ def markers_of(loop: str, points: Points) -> dict[str, float | None]:
         return result
     freq = [point["freq_hz"] for point in usable]
     if loop == "plant":
-        dips = coherent(points, MIN_DIP_COHERENCE)
         result["resonance_hz"] = resonances(freq, [point["magnitude_db"] for point in usable])["resonance_hz"]
-        dip_freq, dip_db = [point["freq_hz"] for point in dips], [point["magnitude_db"] for point in dips]
-        result["antiresonance_hz"] = resonances(dip_freq, dip_db)["antiresonance_hz"]
+        result["antiresonance_hz"] = _antiresonance(points, result["resonance_hz"])
         return result
     result["bandwidth_hz"] = bandwidth(freq, [point["magnitude_db"] for point in usable])
     open_db, open_phase = _open_loop(usable)
     result.update(margins(freq, open_db, _branch(freq, open_db, open_phase)))
     return result
+
+
+def _antiresonance(points: Points, resonance_hz: float | None) -> float | None:
+    """The strongest dip below the resonance, on points γ² ≥ ``MIN_DIP_COHERENCE``: without a resonance there is no
+    anti-resonance (a dip the noise of a loaded host digs among a rigid plant's top points, γ² 0.84–0.96, is none)."""
+    if resonance_hz is None:
+        return None
+    below = [point for point in coherent(points, MIN_DIP_COHERENCE) if point["freq_hz"] < resonance_hz]
+    freq, plant_db = [point["freq_hz"] for point in below], [point["magnitude_db"] for point in below]
+    return resonances(freq, plant_db)["antiresonance_hz"]
 
 
 def coherent(points: Points, threshold: float = MIN_COHERENCE) -> list[Mapping[str, float]]:

@@ -96,11 +96,23 @@ function extremum(freq: number[], values: number[], sign: 1 | -1, prominence = 3
   return best;
 }
 
+/** The points of a response below `limit` Hz. */
+function below(response: Response, limit: number): Response {
+  const keep = (_: unknown, n: number) => response.freq[n] < limit;
+  const coherence = response.coherence?.filter(keep);
+  return { freq: response.freq.filter(keep), value: response.value.filter(keep), ...(coherence ? { coherence } : {}) };
+}
+
+/** The strongest peak, and the strongest dip below it (measured on the motor, a two-mass plant's zero pair lies below
+ * its pole pair): without a resonance there is no anti-resonance, so noise digging a dip among a rigid plant's top
+ * points is not one (markers.py). */
 export function resonances(response: Response): { resonance_hz: number | null; antiresonance_hz: number | null } {
   const plant = coherentPart(response);
   if (plant.freq.length < 2) return { resonance_hz: null, antiresonance_hz: null };
-  const dips = coherentPart(response, MIN_DIP_COHERENCE);
-  return { resonance_hz: extremum(plant.freq, detrended(plant), 1), antiresonance_hz: extremum(dips.freq, detrended(dips), -1) };
+  const resonance = extremum(plant.freq, detrended(plant), 1);
+  if (resonance === null) return { resonance_hz: null, antiresonance_hz: null };
+  const dips = below(coherentPart(response, MIN_DIP_COHERENCE), resonance);
+  return { resonance_hz: resonance, antiresonance_hz: extremum(dips.freq, detrended(dips), -1) };
 }
 
 /** Every marker of a set of responses (the plant may be absent: a closed-loop measurement). */
