@@ -30,6 +30,45 @@ def test_builtin_xtrapulspac_is_listed_and_browsable(client: TestClient) -> None
     assert "Servo Loops" in od["groups"]
 
 
+@pytest.mark.parametrize(
+    ("device", "fieldbus", "named"),
+    [
+        (
+            "xtrapulspac",
+            "CANopen",
+            {"statusword": [0x6041, 0], "dc_link_voltage": [0x6079, 0], "torque_actual": [0x6077, 0]},
+        ),
+        ("ttapro", "PROFIBUS-DP", {"statusword": [0x801, 0], "position_actual": [774, 0], "dc_bus_voltage": [706, 0]}),
+    ],
+)
+def test_a_dictionary_names_its_entries_by_the_device_profiles_meaning(
+    client: TestClient, device: str, fieldbus: str, named: dict[str, list[int]]
+) -> None:
+    """The dashboard finds the status word and the measurements by name: 0x6041 on a CANopen drive, the PZD status
+    word on a TTA-PRO; only names whose entry the dictionary has (the TTA-PRO has no 0x6061 mode display)."""
+    od = client.get(f"/api/dictionaries/{device}").json()
+    assert od["fieldbus"] == fieldbus
+    assert named.items() <= od["names"].items()
+    present = {(obj["index"], sub["subindex"]) for obj in od["objects"] for sub in obj["subs"]}
+    assert all(tuple(address) in present for address in od["names"].values())
+    assert ("modes_of_operation_display" in od["names"]) == (fieldbus == "CANopen")
+
+
+@pytest.mark.parametrize(
+    ("device", "files"),
+    [
+        ("xtrapulspac", ["DRIVEPAR.TXT", "USER_PAR.TXT", "SEQUENCE.TXT"]),
+        ("cd1k", ["DRIVEPAR.TXT"]),
+        ("ttapro", ["TTAPAR.TXT", "TTASEQ.TXT"]),
+    ],
+)
+def test_a_dictionary_names_the_files_a_backup_of_its_device_holds(
+    client: TestClient, device: str, files: list[str]
+) -> None:
+    """The backup page offers these files; each one downloads from a drive of the device (tested per device)."""
+    assert client.get(f"/api/dictionaries/{device}").json()["files"] == files
+
+
 def test_unknown_dictionary_is_404_naming_the_known_ones(client: TestClient) -> None:
     response = client.get("/api/dictionaries/nosuchdrive")
     assert response.status_code == 404

@@ -5,7 +5,7 @@ negative PKW replies as readable errors, the parameter file downloaded, and scop
 from __future__ import annotations
 
 import pytest
-from tests.support.jobs_api import finished
+from tests.support.jobs_api import armed, finished
 from tests.support.profibus_line import tool_on_line, ttapro_line
 
 NODE = "/api/buses/pb/nodes/5"
@@ -68,16 +68,50 @@ def test_the_parameter_file_downloads_and_uploads_in_its_own_syntax(client, line
     assert good.status_code == 200 and good.json()["ok"] and line.slaves[5].memory.get(760) == 1200
 
 
-def test_the_bus_wide_backup_and_restore_jobs_carry_ttapar(client, line):
+def test_a_restore_is_refused_while_the_drive_is_enabled_and_writes_nothing(client, line):
+    """The TTA-PRO saves (PNU 729) and takes its motor data only with the drive disabled (``save_needs_disabled``):
+    the upload is refused before its first write, whatever the file holds."""
+    memory = line.slaves[5].memory
+    before = memory.get(730)
+    upload = f"721,0={memory.get(721)}\n730,0={before + 1}\n".encode()
+    with armed(client, NODE, "motion") as (_, header):
+        enabled = client.put(f"{NODE}/state", json={"target": "operation-enabled"}, headers=header)
+        assert enabled.status_code == 200, enabled.text
+        try:
+            refused = client.put(f"{NODE}/files/TTAPAR.TXT", content=upload)
+            assert refused.status_code == 409, refused.text
+            assert refused.json()["detail"] == (
+                "node 5: ttapro stores parameters only with the drive disabled; disable it first — nothing was written"
+            )
+            assert client.get(f"{NODE}/state").json()["state"] == "OPERATION ENABLED"  # the restore left it so
+        finally:
+            client.put(f"{NODE}/state", json={"target": "switch-on-disabled"})
+    assert int(client.get(f"{NODE}/objects/kp_speed").json()["raw"]) == before == memory.get(730)
+
+
+def test_the_bus_wide_backup_and_restore_jobs_carry_ttapar_and_ttaseq(client, line):
+    sequences = line.slaves[5].sequences
+    sequences.eeprom[7] = {**sequences.eeprom[7], 782: 1, 783: 4321, 784: 900, 785: 50, 786: 60, 788: -1}
+    sequences.stored_checksum = sequences.checksum()
     directory = client.app.state.server.settings.projects_dir / "line-backup"
     backup = client.post("/api/buses/pb/backup", json={"directory": str(directory), "nodes": [5]})
     assert backup.status_code == 202 and finished(client, backup.json()["id"])["state"] == "done"
     saved = (directory / "node5" / "TTAPAR.TXT").read_text().splitlines()
     assert len(saved) == 81 and f"760,0={line.slaves[5].memory.get(760)}" in saved
+    table = (directory / "node5" / "TTASEQ.TXT").read_text().splitlines()
+    assert table[1:5] == ["782,7=1", "783,7=4321", "784,7=900", "785,7=50"] and len(table) == 14
     client.put(f"{NODE}/objects/PNU760", json={"value": 777})
+    sequences.eeprom[7] = {**sequences.eeprom[7], 783: 1}
     restore = client.post("/api/buses/pb/restore", json={"directory": str(directory), "nodes": [5]})
     assert restore.status_code == 202 and finished(client, restore.json()["id"])["state"] == "done"
     assert f"760,0={line.slaves[5].memory.get(760)}" in saved and line.slaves[5].memory.get(760) != 777
+    assert sequences.eeprom[7][783] == 4321 and sequences.checksum_valid
+
+
+def test_a_bad_sequence_table_upload_is_refused_with_its_line(client, line):
+    refused = client.put(f"{NODE}/files/TTASEQ.TXT", content="; table\n782,3=1\n785,3=0\n")
+    assert refused.status_code == 422, refused.text
+    assert refused.json()["detail"].startswith("TTASEQ.TXT:3: sequence 3: PNU 785 Sequence acceleration: 0 is outside")
 
 
 def test_scope_roll_and_nmt_are_refused_with_the_reason(client):

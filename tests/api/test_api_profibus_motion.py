@@ -3,21 +3,18 @@
 disabled), done by it and in the audit log; the controller's loss quick-stops the axis; faults with the manual's
 texts, and their reset; a held jog
 moving the axis and stopping when its keepalives stop or its event socket closes. Through both DP masters (ours over
-TCP, pyprofibus's over the pty); the held jogs through ours (``own_master_only``)."""
+TCP, pyprofibus's over the pty); the held jogs through ours (``own_master_only``), a timed jog stopped by its
+controller's loss through both."""
 
 from __future__ import annotations
 
-import contextlib
-import threading
 import time
-from collections.abc import Callable, Iterator
 
 import pytest
-from tests.support.access import admin_app, api_client
 from tests.support.dp_masters import OWN_MASTER, PYPROFIBUS
-from tests.support.profibus_line import TtaProLine, ttapro_line
+from tests.support.jobs_api import armed, eventually, holding
+from tests.support.profibus_line import TtaProLine, tool_on_line, ttapro_line
 
-from servostudio.services.settings import Settings
 from servostudio.sim.drive.statemachine import State
 from servostudio.sim.profibus.endpoints import ProfibusPty
 from servostudio.sim.profibus.faults import FOLLOWING_ERROR
@@ -44,47 +41,17 @@ def line(request):
 
 
 @pytest.fixture(scope="module")
-def app(tmp_path_factory, line):
-    root = tmp_path_factory.mktemp("api-profibus-motion")
-    return admin_app(Settings(projects_dir=root / "store", static_dir=root / "no-ui", buses=[]), root / "data")
-
-
-@pytest.fixture
-def client(app, line):
-    with api_client(app) as test_client:
-        if "pb" not in [bus["id"] for bus in test_client.get("/api/buses").json()]:
-            assert test_client.post("/api/buses", json={"spec": line.spec, "id": "pb"}).status_code == 201
+def client(tmp_path_factory, line):
+    """One server on each line for the module's tests, shut down after the last."""
+    with tool_on_line(tmp_path_factory.mktemp("api-profibus-motion"), line) as test_client:
         yield test_client
-        test_client.post(f"{MOTION}/stop")
-        test_client.put(f"{NODE}/state", json={"target": "switch-on-disabled"})
 
 
-@contextlib.contextmanager
-def armed(client) -> Iterator[tuple[object, dict[str, str]]]:
-    """A live client (event socket) that armed the axis, and the header naming it."""
-    with client.websocket_connect("/api/ws/events?types=motion") as socket:
-        header = {"X-Servo-Client": socket.receive_json()["client"]}
-        assert client.post(f"{NODE}/control/arm", headers=header).status_code == 200
-        yield socket, header
-
-
-@contextlib.contextmanager
-def holding(socket) -> Iterator[None]:
-    """Keepalives every 20 ms from a thread of their own while the block runs, as a held button sends them (also
-    while the jog's request is on its way)."""
-    stop = threading.Event()
-
-    def send() -> None:
-        while not stop.wait(0.02):
-            socket.send_json({"type": "keepalive", "bus": "pb", "node": 5})
-
-    sender = threading.Thread(target=send, daemon=True)
-    sender.start()
-    try:
-        yield
-    finally:
-        stop.set()
-        sender.join()
+@pytest.fixture(autouse=True)
+def stopped(client):
+    yield
+    client.post(f"{MOTION}/stop")
+    client.put(f"{NODE}/state", json={"target": "switch-on-disabled"})
 
 
 def drive_state(line) -> State:
@@ -98,21 +65,12 @@ def position(line) -> float:
         return line.slaves[5].drive.axis.position
 
 
-def eventually(condition: Callable[[], bool], timeout: float = 2.0) -> float:
-    """Seconds until ``condition`` held (fails after ``timeout``)."""
-    start = time.monotonic()
-    while not condition():
-        assert time.monotonic() - start < timeout, "the condition never held"
-        time.sleep(0.005)
-    return time.monotonic() - start
-
-
 def test_enabling_needs_the_armed_controller_and_is_audited(client, line):
     refused = client.put(f"{NODE}/state", json={"target": "operation-enabled"})
     assert refused.status_code == 409 and "arm" in refused.json()["detail"]
     assert drive_state(line) is State.SWITCH_ON_DISABLED  # refused before the first step: nothing was sent
     assert client.get(f"{NODE}/state").json()["state"] == "SWITCH ON DISABLED"
-    with armed(client) as (_, header):
+    with armed(client, NODE, "motion") as (_, header):
         enabled = client.put(f"{NODE}/state", json={"target": "operation-enabled"}, headers=header)
         assert enabled.status_code == 200, enabled.text
         assert enabled.json()["state"] == "OPERATION ENABLED" and drive_state(line) is State.OPERATION_ENABLED
@@ -126,7 +84,7 @@ def test_enabling_needs_the_armed_controller_and_is_audited(client, line):
 
 
 def test_the_controllers_loss_quick_stops_the_axis(client, line):
-    with armed(client) as (_, header):
+    with armed(client, NODE, "motion", release=False) as (_, header):
         assert client.put(f"{NODE}/state", json={"target": "operation-enabled"}, headers=header).status_code == 200
     eventually(lambda: drive_state(line) is not State.OPERATION_ENABLED)
     query = {"axis": "pb:5", "action": "quick_stop", "limit": 1}
@@ -164,9 +122,9 @@ def own_master_only(request) -> None:
 
 def test_a_held_jog_moves_the_axis_and_stops_when_its_keepalives_stop(client, line, request):
     own_master_only(request)
-    with armed(client) as (socket, header):
+    with armed(client, NODE, "motion") as (socket, header):
         before = position(line)
-        with holding(socket):
+        with holding(socket, "pb", 5):
             started = client.post(f"{MOTION}/jog", json={"velocity": -120, "hold": True}, headers=header)
             assert started.status_code == 200, started.text
             assert int(client.get(f"{NODE}/objects/jog_speed").json()["raw"]) == 120
@@ -182,9 +140,9 @@ def test_a_held_jog_moves_the_axis_and_stops_when_its_keepalives_stop(client, li
 
 def test_a_jog_stops_when_its_clients_socket_closes(client, line, request):
     own_master_only(request)
-    with armed(client) as (socket, header):
+    with armed(client, NODE, "motion", release=False) as (socket, header):
         before = position(line)
-        with holding(socket):
+        with holding(socket, "pb", 5):
             started = client.post(f"{MOTION}/jog", json={"velocity": 120, "hold": True}, headers=header)
             assert started.status_code == 200, started.text
             eventually(lambda: position(line) > before + 0.3, timeout=1.0)
@@ -196,8 +154,24 @@ def test_a_jog_stops_when_its_clients_socket_closes(client, line, request):
     eventually(lambda: client.get(MOTION).json()["state"] == "stopped")  # its follower saw the axis disabled
 
 
+def test_a_jog_stops_when_its_controller_goes_away_through_either_master(client, line):
+    """The held jog's keepalives are too late through pyprofibus on this host (``own_master_only``); a timed jog
+    shows through both masters that the axis moves and stops once its controller's socket closes."""
+    with armed(client, NODE, "motion", release=False) as (_, header):
+        before = position(line)
+        started = client.post(f"{MOTION}/jog", json={"velocity": 120, "seconds": 5}, headers=header)
+        assert started.status_code == 200, started.text
+        eventually(lambda: position(line) > before + 0.3, timeout=2.0)
+    eventually(lambda: drive_state(line) is not State.OPERATION_ENABLED, timeout=1.0)
+    eventually(lambda: line.slaves[5].drive.axis.stopped, timeout=2.0)
+    stopped_at = position(line)
+    time.sleep(0.2)
+    assert position(line) == pytest.approx(stopped_at, abs=0.05)  # and stays stopped (the jog ran 2.4 rad in 0.2 s)
+    eventually(lambda: client.get(MOTION).json()["state"] == "stopped")
+
+
 def test_a_timed_jog_ends_with_the_jog_bit_cleared_and_the_axis_enabled(client, line):
-    with armed(client) as (_, header):
+    with armed(client, NODE, "motion") as (_, header):
         assert client.post(f"{MOTION}/jog", json={"velocity": 60, "seconds": 0.3}, headers=header).status_code == 200
         eventually(lambda: client.get(MOTION).json()["state"] != "running", timeout=2.0)
         assert client.get(MOTION).json()["state"] == "done"
@@ -206,12 +180,12 @@ def test_a_timed_jog_ends_with_the_jog_bit_cleared_and_the_axis_enabled(client, 
         eventually(lambda: line.slaves[5].drive.axis.stopped, timeout=1.0)
 
 
-def test_a_held_jog_whose_hold_expires_while_it_starts_does_not_run_on(app, client, line, request):
+def test_a_held_jog_whose_hold_expires_while_it_starts_does_not_run_on(client, line, request):
     own_master_only(request)
-    holds = app.state.server.motion.motions.holds
+    holds = client.app.state.server.motion.motions.holds
     holds.timeout = 0.001  # expires before the jog is enabled, as a slow start or late keepalives make it
     try:
-        with armed(client) as (_, header):
+        with armed(client, NODE, "motion") as (_, header):
             started = client.post(f"{MOTION}/jog", json={"velocity": 120, "hold": True}, headers=header)
             # ended by its watchdog while starting; or the watchdog's quick stop met the walk up half-way (409 stuck)
             assert (started.status_code, started.json().get("state")) in ((200, "stopped"), (409, None)), started.text

@@ -7,15 +7,22 @@ whose keepalives stop is quick-stopped. Through the project's own DP master (the
 
 from __future__ import annotations
 
+import dataclasses
+from collections.abc import Iterator
+from contextlib import contextmanager
+
 import pytest
-from tests.api.test_api_profibus_motion import MOTION, NODE, armed, eventually, holding
+from tests.support.jobs_api import armed, eventually, holding
 from tests.support.profibus_line import tool_on_line, ttapro_line
 
 from servostudio.sim.drive.statemachine import State
 from servostudio.sim.profibus.faults import FOLLOWING_ERROR
 
+SWITCH_POSITIVE = 0x10  # PNU 766: search the home switch, positive direction
 MARKER_RESET = 0xA0  # PNU 766: search the marker pulse, positive, set the counter to PNU 768
 HERE_RESET = 0x80  # PNU 766: home on the current position, counter set to PNU 768
+NODE = "/api/buses/pb/nodes/5"
+MOTION = f"{NODE}/motion"
 
 
 @pytest.fixture(scope="module")
@@ -51,7 +58,7 @@ def finished(client, timeout: float = 3.0) -> dict:
 
 def test_an_absolute_move_ends_at_its_target_when_the_drive_reports_it_reached(client, line):
     target = counter(line) + 2048  # half a revolution (PNU 870: 4096 per revolution)
-    with armed(client) as (_, header):
+    with armed(client, NODE, "motion") as (_, header):
         body = {"distance": target, "absolute": True, "velocity": 120}
         started = client.post(f"{MOTION}/move", json=body, headers=header)
         assert started.status_code == 200, started.text
@@ -67,7 +74,7 @@ def test_an_absolute_move_ends_at_its_target_when_the_drive_reports_it_reached(c
 
 def test_a_held_relative_move_goes_its_distance_backwards(client, line):
     before = counter(line)
-    with armed(client) as (socket, header), holding(socket):
+    with armed(client, NODE, "motion") as (socket, header), holding(socket, "pb", 5):
         started = client.post(f"{MOTION}/move", json={"distance": -1024, "hold": True}, headers=header)
         assert started.status_code == 200, started.text
         ended = finished(client)
@@ -76,8 +83,8 @@ def test_a_held_relative_move_goes_its_distance_backwards(client, line):
 
 
 def test_a_held_move_whose_keepalives_stop_is_quick_stopped(client, line):
-    with armed(client) as (socket, header):
-        with holding(socket):
+    with armed(client, NODE, "motion") as (socket, header):
+        with holding(socket, "pb", 5):
             body = {"distance": 4000, "hold": True, "velocity": 30}  # 2 s at 30 rpm: still running when released
             assert client.post(f"{MOTION}/move", json=body, headers=header).status_code == 200
         ended = finished(client, timeout=1.0)
@@ -88,7 +95,7 @@ def test_a_held_move_whose_keepalives_stop_is_quick_stopped(client, line):
 @pytest.mark.parametrize("configuration", [HERE_RESET, MARKER_RESET])
 def test_homing_sets_the_counter_to_the_homing_offset_when_the_drive_reports_home_found(client, line, configuration):
     assert client.put(f"{NODE}/objects/home_offset", json={"value": 1000}).status_code == 200  # PNU 768
-    with armed(client) as (_, header):
+    with armed(client, NODE, "motion") as (_, header):
         body = {"method": configuration, "velocity": 120}
         started = client.post(f"{MOTION}/home", json=body, headers=header)
         assert started.status_code == 200, started.text
@@ -121,3 +128,32 @@ def test_state_changes_on_the_line_are_drive_state_events_and_the_state_has_no_n
         assert event["statusword"] & 0x0008
         assert client.post(f"{NODE}/faults/reset").status_code == 200
         assert events.receive_json()["state"] == "SWITCH ON DISABLED"
+
+
+@contextmanager
+def no_home_switch_between_close_limits(line) -> Iterator[None]:
+    """The simulated machine with its limit switches half a turn either side of the axis and no home switch (what
+    the plant has is swapped while the line is locked, and put back)."""
+    with line.line.lock:
+        physics = line.slaves[5].drive.axis.physics
+        plant, turns = physics.plant, physics.load_turns
+        physics.plant = dataclasses.replace(
+            plant, home_switch=None, negative_limit_switch=turns - 0.5, positive_limit_switch=turns + 0.5
+        )
+    try:
+        yield
+    finally:
+        with line.line.lock:
+            physics.plant = plant
+
+
+def test_a_homing_the_drive_fails_ends_failed_with_the_drives_fault_in_the_manuals_words(client, line):
+    with no_home_switch_between_close_limits(line), armed(client, NODE, "motion") as (_, header):
+        body = {"method": SWITCH_POSITIVE, "velocity": 120}  # 2 turns/s: the second limit switch after ≈ 0.8 s
+        started = client.post(f"{MOTION}/home", json=body, headers=header)
+        assert started.status_code == 200, started.text
+        ended = finished(client, timeout=4.0)
+    assert ended["state"] == "failed", ended
+    assert ended["reason"] == "the drive faulted: HOME: homing procedure timeout error"  # PNU 773 bit 16
+    assert client.get(f"{NODE}/state").json()["state"] == "FAULT"
+    assert client.post(f"{NODE}/faults/reset").status_code == 200

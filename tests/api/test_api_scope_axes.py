@@ -5,8 +5,8 @@ from __future__ import annotations
 
 import time
 
-from tests.api.test_api_scope import finished
 from tests.support.access import admin_app, api_client
+from tests.support.jobs_api import finished
 
 from servostudio.services.settings import Settings
 
@@ -21,7 +21,7 @@ def test_a_two_axis_recorder_capture_job_says_how_it_was_armed(tmp_path, sim_ope
         scope = f"/api/buses/{bus}/nodes/1/scope"
         plan = client.post(f"{scope}/check", json=DEFINITION).json()
         assert plan["source"] == "recorder" and [c["key"] for c in plan["channels"]] == ["0x6064,0", "0x6041,0@2"]
-        job = finished(client, client.post(f"{scope}/captures", json=DEFINITION).json())
+        job = finished(client, client.post(f"{scope}/captures", json=DEFINITION).json()["id"])
         assert job["state"] == "done", job
         result = job["result"]
         assert result["arm"] == "broadcast" and result["alignment_ns"] == 250_000, result
@@ -47,7 +47,7 @@ def test_a_two_axis_capture_triggered_on_the_other_axis_is_forced_there_and_foll
         assert started.status_code == 202, started.text
         _until(client, f"/api/buses/{bus}/nodes/2/scope/status", "waiting")
         assert client.post(f"{scope}/force").status_code == 200
-        job = finished(client, started.json())
+        job = finished(client, started.json()["id"])
         assert job["state"] == "done", job
         result = job["result"]
         assert result["arm"] == "relay" and result["alignment_ns"] == 250_000, result

@@ -5,8 +5,8 @@ over-subscribed roll is refused with 422 before anything is armed; the socket's 
 from __future__ import annotations
 
 import pytest
-from tests.services.scope.test_scope_tpdo import tpdo_configuration
 from tests.support.access import admin_app, api_client
+from tests.support.sync_probe import tpdo_configuration
 
 from servostudio.services.settings import Settings
 

@@ -14,9 +14,8 @@ import sys
 import threading
 
 import pytest
-from tests.services.frequency.conftest import free
-from tests.services.frequency.test_measure_plants import plant_error
 from tests.support.motion_timing import InProcessServer
+from tests.support.plant_truth import free, plant_error
 
 from servostudio.sim import network as sim_network
 from servostudio.sim.drive import make_behaviour

@@ -1,7 +1,8 @@
 """Saved frequency responses over REST: a plant response of a true rigid plant saved by the store, listed, read back
-with its points, downloaded as the pinned CSV and as a standalone HTML file holding the traces and plotly.js
-inline, overlaid with another, deleted by an Expert only; unknown names and damaged files refused with their
-reason. No drive is needed: saved results are project records."""
+with its points and the markers its points have (not the ones it was saved with), downloaded as the pinned CSV and
+as a standalone HTML file holding the traces, plotly.js inline and a true two-mass plant's resonance, overlaid with
+another, deleted by an Expert only; unknown names and damaged files refused with their reason. No drive is needed:
+saved results are project records."""
 
 from __future__ import annotations
 
@@ -38,10 +39,28 @@ def true_plant(name_hz: float = 5.0, points: int = 30) -> dict:
         "excitation": {"type": "multisine", "from_hz": 5, "to_hz": 400, "points": points, "amplitude_pct": 10},
         "points": rows,
         "markers": {"bandwidth_hz": None, "gain_margin_db": None, "phase_margin_deg": None,
-                    "resonance_hz": 123.0, "antiresonance_hz": None},
+                    "resonance_hz": 123.0, "antiresonance_hz": None},  # stale: a rigid plant has none
         "plant_fit": {"inertia_kgm2": INERTIA, "viscous_friction_nms_per_rad": FRICTION},
         "gains": {"kp_a_per_rad_s": 0.2}, "aborted": None,
     }  # fmt: skip
+
+
+JM, JL, RESONANCE_HZ = 2e-4, 4e-4, 140.0
+
+
+def two_mass_plant() -> dict:
+    """A plant measurement of a motor J_M coupled to a load J_L, resonating at 140 Hz (lightly damped)."""
+    stiffness = JM * JL / (JM + JL) * (2 * math.pi * RESONANCE_HZ) ** 2
+    damping = 0.05 * 2 * math.sqrt(stiffness * JM * JL / (JM + JL))
+    rows = []
+    for number in range(40):
+        frequency = 5.0 * 1.1**number
+        s = complex(0, 2 * math.pi * frequency)
+        load = JL * s**2 + damping * s + stiffness
+        value = load / (s * (JM * load + JL * (damping * s + stiffness)))
+        rows.append({"freq_hz": frequency, "magnitude_db": 20 * math.log10(abs(value)),
+                     "phase_deg": math.degrees(math.atan2(value.imag, value.real)), "coherence": 0.99})  # fmt: skip
+    return {**true_plant(), "time": "2026-12-01T08:00:00Z", "points": rows, "markers": None}
 
 
 @pytest.fixture(scope="module")
@@ -52,6 +71,7 @@ def app(tmp_path_factory):
     app = admin_app(settings, root / "data")
     projects = app.state.server.projects.store
     store.save(projects, "demo", "X", true_plant(), "rigid")
+    store.save(projects, "demo", "X", two_mass_plant(), "two-mass")
     store.save(projects, "demo", "X", {**true_plant(8.0, 12), "loop": "closed", "time": "2026-12-02T09:00:00Z"})
     return app
 
@@ -64,8 +84,8 @@ def client(app):
 
 def test_listed_newest_first_and_read_back_with_its_points(client):
     listed = client.get(BASE).json()
-    assert [item["loop"] for item in listed] == ["closed", "plant"]
-    assert listed[1]["name"] == "rigid" and listed[1]["markers"]["resonance_hz"] == 123.0
+    assert [item["loop"] for item in listed] == ["closed", "plant", "plant"]
+    assert listed[1]["name"] == "rigid" and listed[1]["markers"]["resonance_hz"] is None  # not the 123 Hz saved
     full = client.get(f"{BASE}/rigid").json()
     written = true_plant()["points"]
     assert len(full["points"]) == len(written)
@@ -94,14 +114,16 @@ def plotted(document: str) -> list[dict]:
 
 def test_the_html_is_standalone_with_the_traces_and_markers(client):
     other = client.get(BASE).json()[0]["name"]
-    answer = client.get(f"{BASE}/rigid/html", params={"compare": [other]})
+    answer = client.get(f"{BASE}/rigid/html", params={"compare": [other, "two-mass"]})
     assert answer.status_code == 200 and answer.headers["content-type"].startswith("text/html")
     document = answer.text
     assert not re.search(r"<script[^>]+src=", document)  # plotly.js inline: opens offline
     traces = plotted(document)
-    assert len(traces) == 6  # magnitude, phase, coherence of both results
+    assert len(traces) == 9  # magnitude, phase, coherence of the three results
     assert traces[0]["y"][0] == pytest.approx(true_plant()["points"][0]["magnitude_db"], rel=1e-5)
-    assert "anti-resonance" in document and "resonance" in document and "123 Hz" in document
+    resonance = client.get(f"{BASE}/two-mass").json()["markers"]["resonance_hz"]
+    assert resonance == pytest.approx(RESONANCE_HZ, rel=0.05)
+    assert f"resonance {resonance:.4g} Hz" in document and "123 Hz" not in document
 
 
 def test_unknown_names_and_damaged_files_are_refused(client, app):

@@ -4,12 +4,12 @@ target (0x6064), homing ending homed, jogs, limits refused before the bus, and t
 
 from __future__ import annotations
 
-import contextlib
+import threading
 import time
-from collections.abc import Iterator
 
 import pytest
 from tests.support.access import admin_app, api_client
+from tests.support.jobs_api import armed
 
 from servostudio.api.app import Settings
 
@@ -29,15 +29,6 @@ def client(app):
         yield client
         client.post(f"{MOTION}/stop")
         client.put(f"{NODE}/state", json={"target": "switch-on-disabled"})
-
-
-@contextlib.contextmanager
-def armed(client) -> Iterator[tuple[object, dict[str, str]]]:
-    """A live client (event socket) that armed the axis, and the header naming it."""
-    with client.websocket_connect("/api/ws/events?types=motion") as socket:
-        header = {"X-Servo-Client": socket.receive_json()["client"]}
-        assert client.post(f"{NODE}/control/arm", headers=header).status_code == 200
-        yield socket, header
 
 
 def read(client, key: str) -> int:
@@ -86,7 +77,7 @@ def test_the_terminal_socket_cannot_start_the_jog_either(client):
 
 
 def test_relative_then_absolute_moves_reach_their_targets(client):
-    with armed(client) as (_, header):
+    with armed(client, NODE, "motion") as (_, header):
         start = read(client, "0x6064")
         relative = client.post(f"{MOTION}/move", json={"distance": 2048, "velocity": 120}, headers=header)
         assert relative.status_code == 200, relative.text
@@ -101,7 +92,7 @@ def test_relative_then_absolute_moves_reach_their_targets(client):
 
 
 def test_homing_on_the_current_position_ends_homed(client):
-    with armed(client) as (socket, header):
+    with armed(client, NODE, "motion") as (socket, header):
         started = client.post(f"{MOTION}/home", json={"method": 35}, headers=header)
         assert started.status_code == 200, started.text
         ended = wait_end(client)
@@ -114,7 +105,7 @@ def test_homing_on_the_current_position_ends_homed(client):
 
 
 def test_homing_with_an_index_pulse_search_ends_homed(client):
-    with armed(client) as (_, header):
+    with armed(client, NODE, "motion") as (_, header):
         started = client.post(f"{MOTION}/home", json={"method": 34, "velocity": 30}, headers=header)
         assert started.status_code == 200, started.text
         ended = wait_end(client, timeout=30)
@@ -123,7 +114,7 @@ def test_homing_with_an_index_pulse_search_ends_homed(client):
 
 
 def test_an_unknown_homing_method_is_refused_before_the_bus(client):
-    with armed(client) as (_, header):
+    with armed(client, NODE, "motion") as (_, header):
         refused = client.post(f"{MOTION}/home", json={"method": 16}, headers=header)
         assert refused.status_code == 422 and "no homing method 16" in refused.json()["detail"]
     assert read(client, "0x6098") != 16
@@ -137,7 +128,7 @@ def test_the_homing_methods_carry_the_manuals_descriptions(client):
 
 
 def test_a_timed_jog_runs_then_stands_still(client):
-    with armed(client) as (_, header):
+    with armed(client, NODE, "motion") as (_, header):
         started = client.post(f"{MOTION}/jog", json={"velocity": 120, "seconds": 0.5}, headers=header)
         assert started.status_code == 200, started.text
         time.sleep(0.3)
@@ -157,7 +148,7 @@ def test_a_timed_jog_runs_then_stands_still(client):
     ],
 )
 def test_above_the_default_limits_is_refused_before_the_bus(client, route, body, limit):
-    with armed(client) as (_, header):
+    with armed(client, NODE, "motion") as (_, header):
         target_velocity, target_position = read(client, "0x60FF"), read(client, "0x607A")
         refused = client.post(f"{MOTION}/{route}", json=body, headers=header)
         assert refused.status_code == 422 and limit in refused.json()["detail"], refused.text
@@ -171,7 +162,7 @@ def test_the_user_can_raise_a_limit_and_then_move_further(client):
     assert raised.json()["distance_revolutions"] == 2.5 and raised.json()["velocity_rpm"] == 300.0
     assert client.put(f"{MOTION}/limits", json={"velocity_rpm": -1}).status_code == 422
     try:
-        with armed(client) as (_, header):
+        with armed(client, NODE, "motion") as (_, header):
             start = read(client, "0x6064")
             moved = client.post(f"{MOTION}/move", json={"distance": 8192, "velocity": 240}, headers=header)
             assert moved.status_code == 200, moved.text
@@ -182,7 +173,7 @@ def test_the_user_can_raise_a_limit_and_then_move_further(client):
 
 
 def test_a_held_jog_runs_while_keepalives_arrive_and_stops_when_they_stop(client):
-    with armed(client) as (socket, header):
+    with armed(client, NODE, "motion") as (socket, header):
         started = client.post(f"{MOTION}/jog", json={"velocity": 60, "hold": True}, headers=header)
         assert started.status_code == 200, started.text
         for _ in range(25):  # half a second of keepalives, more often than the UI's: a loaded host delays some
@@ -195,11 +186,50 @@ def test_a_held_jog_runs_while_keepalives_arrive_and_stops_when_they_stop(client
         assert client.get(f"{NODE}/state").json()["state"] in ("QUICK STOP ACTIVE", "SWITCH ON DISABLED")
 
 
+def hold_watchdogs() -> set[threading.Thread]:
+    return {thread for thread in threading.enumerate() if thread.name == "motion-hold-watch"}
+
+
+def test_the_servers_shutdown_ends_its_hold_watchdog(tmp_path):
+    """Every app a process starts and shuts down (each test's) must not leave its watchdog thread behind."""
+    before = hold_watchdogs()
+    app = admin_app(Settings(projects_dir=tmp_path / "p", static_dir=tmp_path / "no-ui", buses=("sim",)), tmp_path)
+    with api_client(app) as client, armed(client, NODE, "motion") as (socket, header):
+        assert client.post(f"{MOTION}/jog", json={"velocity": 30, "hold": True}, headers=header).status_code == 200
+        socket.send_json({"type": "keepalive", "bus": "sim", "node": 2})
+        started = hold_watchdogs() - before
+        assert len(started) == 1  # the app's watchdog runs while it holds a motion
+        assert wait_end(client, timeout=2)["state"] == "stopped"  # and still stops the unheld jog
+    assert not [thread for thread in started if thread.is_alive()]
+
+
 def test_a_second_motion_while_one_runs_is_refused(client):
-    with armed(client) as (_, header):
+    with armed(client, NODE, "motion") as (_, header):
         assert client.post(f"{MOTION}/jog", json={"velocity": 30, "seconds": 2}, headers=header).status_code == 200
         again = client.post(f"{MOTION}/move", json={"distance": 10}, headers=header)
         assert again.status_code == 409 and "stop it first" in again.json()["detail"]
         stopped = client.post(f"{MOTION}/stop")  # anyone may stop
         assert stopped.json()["state"] == "stopped"
         assert client.get(f"{NODE}/state").json()["state"] in ("QUICK STOP ACTIVE", "SWITCH ON DISABLED")
+
+
+def test_a_move_the_drive_faults_in_ends_failed_and_names_the_fault(client):
+    """A linear axis (0x3360 = 1) whose software limit (0x607D,2) the move crosses: the drive faults (error 36),
+    and the motion ends ``failed`` with the fault as the XtrapulsPac's manual names it, not ``stopped``."""
+    here = read(client, "0x6064")
+    limits = {key: read(client, key) for key in ("0x3360", "0x607D,1", "0x607D,2")}
+    crossed = {"0x3360": 1, "0x607D,1": here - 100_000, "0x607D,2": here + 1000}
+    try:
+        for key, value in crossed.items():
+            assert client.put(f"{NODE}/objects/{key}", json={"value": value}).status_code == 200
+        with armed(client, NODE, "motion") as (_, header):
+            started = client.post(f"{MOTION}/move", json={"distance": 2048, "velocity": 300}, headers=header)
+            assert started.status_code == 200, started.text
+            ended = wait_end(client, timeout=5)
+        assert client.get(f"{NODE}/state").json()["state"] == "FAULT"
+    finally:
+        for key, value in limits.items():
+            assert client.put(f"{NODE}/objects/{key}", json={"value": value}).status_code == 200
+        assert client.post(f"{NODE}/faults/reset").status_code == 200
+    assert ended["state"] == "failed", ended
+    assert ended["reason"] == "the drive faulted: Software position limit"

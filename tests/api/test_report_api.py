@@ -6,8 +6,8 @@ projects and axes refused. No drive is needed: the report is made from the proje
 from __future__ import annotations
 
 import pytest
-from tests.services.report.support import BODE_NAME, PLANT_FIT, Page, commissioned, plotted
 from tests.support.access import admin_app, api_client
+from tests.support.report_project import BODE_NAME, PLANT_FIT, Page, commissioned, plotted
 
 from servostudio.api.app import Settings
 from servostudio.services.audit import AuditLog

@@ -3,13 +3,12 @@ download refused whole, download + start as the armed controller, and the monito
 
 from __future__ import annotations
 
-import contextlib
 import time
-from collections.abc import Iterator
 
 import pytest
-from tests.services.sequences.conftest import COUNTER_LOOP
 from tests.support.access import admin_app, api_client
+from tests.support.jobs_api import armed
+from tests.support.sequence_programs import COUNTER_LOOP
 
 from servostudio.api.app import Settings
 
@@ -31,14 +30,6 @@ def client(app):
         client.put(f"{NODE}/state", json={"target": "switch-on-disabled"})
 
 
-@contextlib.contextmanager
-def armed(client) -> Iterator[dict[str, str]]:
-    with client.websocket_connect("/api/ws/events?types=control") as socket:
-        header = {"X-Servo-Client": socket.receive_json()["client"]}
-        assert client.post(f"{NODE}/control/arm", headers=header).status_code == 200
-        yield header
-
-
 def test_check_gives_issues_or_sequences_and_graph(client):
     bad = client.post("/api/sequences/check", json={"text": BAD}).json()
     assert bad["ok"] is False and bad["issues"][0]["line"] == 4 and bad["issues"][0]["keyword"] == "AccelTime"
@@ -58,7 +49,7 @@ def test_start_needs_the_controller_and_the_timeline_shows_the_order(client):
     assert client.put(SEQ, json={"text": COUNTER_LOOP}).json()["verified"]
     assert client.post(f"{SEQ}/start", json={"sequence": 1}).status_code == 409
     client.post(f"{SEQ}/monitor?fresh=true")
-    with armed(client) as header:
+    with armed(client, NODE, "control") as (_, header):
         assert client.post(f"{SEQ}/start", json={"sequence": 1}, headers=header).status_code == 200
         deadline = time.monotonic() + 15
         while True:
@@ -67,7 +58,6 @@ def test_start_needs_the_controller_and_the_timeline_shows_the_order(client):
                 break
             assert time.monotonic() < deadline, snapshot
             time.sleep(0.05)
-        client.post(f"{NODE}/control/release", headers=header)
     assert [run["sequence"] for run in snapshot["executed"]] == [1, 2, 1, 2, 3]
     phases = [(sample["sequence"], sample["phase"]) for sample in snapshot["timeline"]]
     assert (1, "BEGIN") in phases and (3, "END") in phases and phases[-1] == (-1, "IDLE")
@@ -75,6 +65,6 @@ def test_start_needs_the_controller_and_the_timeline_shows_the_order(client):
 
 
 def test_the_conditional_input_is_written(client):
-    with armed(client) as header:
+    with armed(client, NODE, "control") as (_, header):
         answer = client.put(f"{SEQ}/inputs", json={"conditional": "1......."}, headers=header).json()
     assert answer["conditional"] & 0x80

@@ -1,34 +1,23 @@
 """Playwright (Python) driving Debian's Chromium against the real server.
 
 Playwright's own browser download is not available here, so the browser is the system's
-`chromium`, started with the flags a closed network needs.
+`chromium`, started with the flags a closed network needs (those, screenshots and the demo server's handle:
+`tests/support/browser.py`).
 """
 
 from __future__ import annotations
 
 import os
 import shutil
-from dataclasses import dataclass
-from pathlib import Path
 
 import httpx
 import pytest
 from playwright.sync_api import Browser, Page, expect, sync_playwright
+from tests.support.browser import CHROMIUM_ARGS, DemoServer, screenshot  # noqa: F401 -- screenshot: for test_ttapro_*.py
 from tests.support.live_server import REPO_ROOT, LiveServer
 
 # The test machine is shared and slow at times: allow pages more than Playwright's default 5 s to settle.
 expect.set_options(timeout=15_000)
-
-ARTIFACTS = Path(__file__).resolve().parents[2] / "test-artifacts" / "screenshots"
-CHROMIUM_ARGS = [
-    "--no-sandbox",
-    "--disable-gpu",
-    "--disable-quic",
-    "--no-first-run",
-    "--disable-background-networking",
-    "--disable-component-update",
-    "--disable-sync",
-]
 
 
 # Package scope: Playwright's sync API keeps an event loop running while the browser is open, which would
@@ -50,30 +39,6 @@ def page(browser: Browser) -> Page:
     page = context.new_page()
     yield page
     context.close()
-
-
-def screenshot(page: Page, name: str) -> Path:
-    """Save a full-page screenshot as a test artifact (test-artifacts/screenshots/NAME.png)."""
-    ARTIFACTS.mkdir(parents=True, exist_ok=True)
-    path = ARTIFACTS / f"{name}.png"
-    page.screenshot(path=str(path), full_page=True)
-    return path
-
-
-@dataclass(frozen=True)
-class DemoServer:
-    """A real `servostudio serve` whose project store holds a copy of the shipped demo project, with its bus open."""
-
-    url: str
-    project: str
-    bus: str
-    axes: tuple[tuple[str, int], ...]  # (axis name, node ID)
-    projects_dir: Path | None = None  # the server's project store (tests may save records there, as the server would)
-
-    def api(self, method: str, path: str, **kwargs) -> httpx.Response:
-        response = httpx.request(method, self.url + path, timeout=15.0, **kwargs)
-        assert response.is_success, f"{method} {path}: HTTP {response.status_code} {response.text}"
-        return response
 
 
 @pytest.fixture(scope="package")
@@ -115,10 +80,3 @@ def demo_server(tmp_path_factory: pytest.TempPathFactory):
 def live_server(demo_server: DemoServer) -> DemoServer:
     """The browser tests share one server (each runs three simulated drives in real time on a 2-core machine)."""
     return demo_server
-
-
-def xtrapulspac_entries() -> int:
-    """How many entries the editor lists for the XtrapulsPac: every sub-entry of its dictionary, from the EDS."""
-    from servostudio.od import BUILTIN_EDS_DIR, EdsLibrary
-
-    return len(EdsLibrary(BUILTIN_EDS_DIR).load("xtrapulspac"))

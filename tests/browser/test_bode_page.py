@@ -12,13 +12,12 @@ import re
 import httpx
 import pytest
 from playwright.sync_api import Page, expect
+from tests.support.browser import DemoServer, screenshot
 
 from servostudio.od import builtin_library
 from servostudio.services.frequency import store
 from servostudio.services.projects import ProjectService
 from servostudio.sim.plant import Plant
-
-from .conftest import DemoServer, screenshot
 
 AXIS, NODE = "Z", 3
 PERIOD = 250e-6

@@ -5,8 +5,7 @@ revision restorable; compare counts only what a user can write or restore, read-
 import re
 
 from playwright.sync_api import Page, expect
-
-from .conftest import DemoServer, screenshot
+from tests.support.browser import DemoServer, screenshot
 
 STATUSWORD_KEY = f"{0x6041}.0"
 

@@ -5,8 +5,7 @@ drive changes by itself (a procedure's status) follow the drive without Refresh.
 import re
 
 from playwright.sync_api import Page, expect
-
-from .conftest import DemoServer, screenshot
+from tests.support.browser import DemoServer, screenshot
 
 
 def _drive(server: DemoServer, node: int, address: str) -> int:

@@ -10,8 +10,7 @@ from collections.abc import Iterator
 
 import pytest
 from playwright.sync_api import Page, expect
-
-from .conftest import DemoServer, screenshot
+from tests.support.browser import DemoServer, screenshot
 
 BUS, SPEC = "iobus", "sim:11:cd1k,12:encotrive"
 ON = re.compile(r"\bon\b")

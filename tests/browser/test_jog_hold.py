@@ -17,10 +17,9 @@ from collections.abc import Callable
 import httpx
 import pytest
 from playwright.sync_api import Browser, Page, expect
+from tests.support.browser import CHROMIUM_ARGS
 from tests.support.live_server import REPO_ROOT, free_port
 from tests.support.motion_timing import DriveProbe, InProcessServer, KeepaliveLog, wait_until
-
-from .conftest import CHROMIUM_ARGS
 
 BUDGET = 0.2  # seconds from the last keepalive to the stop (issue #13)
 

@@ -23,11 +23,10 @@ from pathlib import Path
 import httpx
 import pytest
 from playwright.sync_api import Page, expect
+from tests.support.browser import screenshot
 from tests.support.live_server import REPO_ROOT, LiveServer
 
 from servostudio.sim.plant import FEEDBACK_ENCODER, Plant
-
-from .conftest import screenshot
 
 SEED = 20261202
 PROCEDURE_TIMEOUT = 90_000  # ms: the simulated drive runs in real time on a shared machine

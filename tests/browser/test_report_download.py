@@ -10,10 +10,9 @@ from collections.abc import Iterator
 
 import pytest
 from playwright.sync_api import Browser, Page, expect
-from tests.services.report.support import commissioned
+from tests.support.browser import screenshot
 from tests.support.live_server import LiveServer
-
-from .conftest import screenshot
+from tests.support.report_project import commissioned
 
 #: the plots of axis X: the speed and position steps of the auto-tuning's verification, the plant Bode
 AXIS_X_PLOTS = ("axis-1-steps-0-speed_step", "axis-1-steps-0-position_step", "axis-1-bode-plant")

@@ -6,8 +6,7 @@ from __future__ import annotations
 import re
 
 from playwright.sync_api import Page, expect
-
-from .conftest import DemoServer, screenshot
+from tests.support.browser import DemoServer, screenshot
 
 REV = 4096
 

@@ -1,10 +1,9 @@
 """The shell page, built by Vite and served by the backend, talks to the live server."""
 
 from playwright.sync_api import Page, expect
+from tests.support.browser import screenshot
 
 from servostudio import __version__
-
-from .conftest import screenshot
 
 
 def test_shell_shows_live_server_version(page: Page, live_server) -> None:

@@ -9,11 +9,10 @@ import time
 
 import pytest
 from playwright.sync_api import Page, expect
+from tests.support.browser import screenshot
 from tests.support.live_server import LiveServer
 
 from servostudio.services.users import Level, UserStore
-
-from .conftest import screenshot
 
 PASSWORD = "correct horse battery"
 

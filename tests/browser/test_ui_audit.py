@@ -2,8 +2,7 @@
 asks for it, the holder is asked and releases, and the audit page lists what happened, filtered by axis."""
 
 from playwright.sync_api import Page, expect
-
-from .conftest import DemoServer
+from tests.support.browser import DemoServer
 
 
 def test_a_second_page_asks_the_holder_and_the_audit_log_shows_it(page: Page, browser, demo_server: DemoServer) -> None:

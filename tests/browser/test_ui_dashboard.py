@@ -5,8 +5,7 @@ import re
 import time
 
 from playwright.sync_api import Page, expect
-
-from .conftest import DemoServer, screenshot
+from tests.support.browser import DemoServer, screenshot
 
 
 def drive_state(server: DemoServer, node: int) -> str:

@@ -3,8 +3,7 @@
 import re
 
 from playwright.sync_api import Page, expect
-
-from .conftest import DemoServer
+from tests.support.browser import DemoServer
 
 ATTEMPTS = 3
 

@@ -3,8 +3,7 @@
 import re
 
 from playwright.sync_api import Page, expect
-
-from .conftest import DemoServer, screenshot
+from tests.support.browser import DemoServer, screenshot
 
 
 def test_new_project_from_a_bus_scan(page: Page, demo_server: DemoServer) -> None:

@@ -1,8 +1,7 @@
 """Parameter editor against the real server and simulated drives (the issue's acceptance test)."""
 
 from playwright.sync_api import Page, expect
-
-from .conftest import DemoServer, screenshot, xtrapulspac_entries
+from tests.support.browser import DemoServer, screenshot, xtrapulspac_entries
 
 ENTRIES = xtrapulspac_entries()
 

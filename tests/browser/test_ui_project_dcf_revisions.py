@@ -7,8 +7,8 @@ from __future__ import annotations
 import re
 
 from playwright.sync_api import Page, expect
-
-from .conftest import REPO_ROOT, DemoServer, screenshot
+from tests.support.browser import DemoServer, screenshot
+from tests.support.live_server import REPO_ROOT
 
 
 def _dcf(position_window_time: int) -> bytes:

@@ -5,8 +5,7 @@ value from the browser."""
 import re
 
 from playwright.sync_api import Page, expect
-
-from .conftest import DemoServer
+from tests.support.browser import DemoServer
 
 
 def test_restore_project_to_drive_runs_one_server_job(page: Page, demo_server: DemoServer) -> None:

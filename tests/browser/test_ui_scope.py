@@ -7,8 +7,7 @@ import re
 import time
 
 from playwright.sync_api import Page, expect
-
-from .conftest import DemoServer, screenshot
+from tests.support.browser import DemoServer, open_scope, screenshot
 
 
 def pick(page: Page, slot: str, query: str, key: str) -> None:
@@ -16,11 +15,6 @@ def pick(page: Page, slot: str, query: str, key: str) -> None:
     page.get_by_test_id(slot).fill(query)
     page.get_by_test_id(f"{slot}-results").get_by_test_id("picker-result").filter(has_text=key).first.click()
     expect(page.get_by_test_id(slot)).to_have_value(re.compile(rf"^{re.escape(key)} "))
-
-
-def open_scope(page: Page, server: DemoServer, axis: str) -> None:
-    page.goto(f"{server.url}/projects/demo/axes/{axis}/scope")
-    expect(page.get_by_test_id("scope-stage")).to_have_text(re.compile(r"Recorder: (idle|done)"))
 
 
 def test_a_triggered_capture_is_read_at_a_cursor_exported_and_saved(page: Page, demo_server: DemoServer, tmp_path):

@@ -9,9 +9,7 @@ import statistics
 import time
 
 from playwright.sync_api import Page, expect
-
-from .conftest import DemoServer, screenshot
-from .test_ui_scope import open_scope
+from tests.support.browser import DemoServer, open_scope, screenshot
 
 
 def samples_drawn(page: Page) -> int:

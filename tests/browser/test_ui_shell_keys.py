@@ -3,8 +3,7 @@
 from pathlib import Path
 
 from playwright.sync_api import Page, expect
-
-from .conftest import DemoServer, screenshot, xtrapulspac_entries
+from tests.support.browser import DemoServer, screenshot, xtrapulspac_entries
 
 ENTRIES = xtrapulspac_entries()
 

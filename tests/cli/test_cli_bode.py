@@ -13,7 +13,7 @@ import sys
 
 import httpx
 import pytest
-from tests.cli.conftest import run
+from tests.support.commands import run
 from tests.support.motion_timing import InProcessServer
 
 QUICK = ("--periods", "2", "--base-speed", "10", "--window", "20")

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import pytest
-from tests.cli.conftest import run_json
+from tests.support.commands import run_json
 
 
 @pytest.fixture(scope="module")

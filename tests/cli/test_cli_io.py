@@ -5,7 +5,7 @@ written."""
 from __future__ import annotations
 
 import pytest
-from tests.cli.conftest import run_json
+from tests.support.commands import run_json
 from tests.support.live_server import LiveServer
 
 

@@ -11,7 +11,7 @@ import io
 import json
 
 import pytest
-from tests.cli.conftest import run
+from tests.support.commands import run
 
 from servostudio.drive.cia402 import State
 from servostudio.drive.control import read_state, set_state

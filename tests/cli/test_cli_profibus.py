@@ -70,6 +70,22 @@ def test_backup_change_restore_round_trip_is_lossless(line, capsys, tmp_path):
     assert again.read_text().splitlines()[1:] == backup.read_text().splitlines()[1:]  # all but the dated header
 
 
+def test_the_sequence_table_round_trip_restores_the_eeprom_with_its_checksum(line, capsys, tmp_path):
+    sequences = line.slaves[5].sequences
+    sequences.eeprom[2] = {**sequences.eeprom[2], 782: 0x0005, 783: -2500, 784: 300, 785: 20, 786: 0, 788: 3}
+    sequences.stored_checksum = sequences.checksum()
+    table = tmp_path / "TTASEQ.TXT"
+    code, result, _ = run(capsys, "backup", "--bus", line.spec, "--node", "5", "--out", str(table))
+    assert code == 0 and result["kind"] == "TTASEQ.TXT" and result["objects"] == 1
+    before = {pnu: sequences.eeprom[2][pnu] for pnu in range(782, 795)}  # 810 is the drive's: 784 in % of 721
+    sequences.eeprom[2], sequences.eeprom[9] = {**before, 788: -1}, {**before}  # a link changed, one more in use
+    code, restored, _ = run(capsys, "restore", "--bus", line.spec, "--node", "5", "--in", str(table))
+    assert code == 0 and restored["ok"] and restored["counts"] == {"verified": 2}, restored
+    assert restored["stored"] == "sequence checksum (sequence_write = 128)"
+    assert {pnu: sequences.eeprom[2][pnu] for pnu in before} == before
+    assert sequences.eeprom[9][782] == 0 and sequences.checksum_valid
+
+
 def test_a_bad_file_is_refused_whole_before_anything_is_written(line, capsys, tmp_path):
     memory = line.slaves[5].memory
     bad = tmp_path / "TTAPAR.TXT"

@@ -6,9 +6,9 @@ atomically and a refusal leaves the previous one whole."""
 from __future__ import annotations
 
 import pytest
-from tests.cli.conftest import run_json
-from tests.services.report.support import PLANT_FIT, Page, commissioned, plotted
+from tests.support.commands import run_json
 from tests.support.live_server import LiveServer
+from tests.support.report_project import PLANT_FIT, Page, commissioned, plotted
 
 from servostudio.services.audit import AuditLog
 

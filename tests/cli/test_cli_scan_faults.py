@@ -6,7 +6,7 @@ from __future__ import annotations
 from types import SimpleNamespace
 
 import pytest
-from tests.cli.conftest import run_json
+from tests.support.commands import run_json
 
 from servostudio.errors import OUTCOMES, ErrorKind
 from servostudio.services.bus import ConnectionManager

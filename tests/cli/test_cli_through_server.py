@@ -14,7 +14,7 @@ import sys
 import time
 
 import pytest
-from tests.cli.conftest import run_json
+from tests.support.commands import run_json
 from tests.support.live_server import LiveServer
 
 from servostudio.cli import main

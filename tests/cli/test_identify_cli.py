@@ -8,8 +8,7 @@ import json
 
 import httpx
 import pytest
-from tests.cli.conftest import run
-from tests.cli.test_procedures_cli_server import servostudio
+from tests.support.commands import run, servostudio
 from tests.support.motion_timing import InProcessServer
 
 from servostudio.sim.plant import Plant

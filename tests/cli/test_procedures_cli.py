@@ -6,7 +6,7 @@ from __future__ import annotations
 import json
 
 import pytest
-from tests.cli.conftest import run
+from tests.support.commands import run
 
 
 @pytest.fixture(autouse=True)

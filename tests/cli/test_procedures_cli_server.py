@@ -4,18 +4,11 @@ duration, the server runs the procedure as a job), the answer is the job's resul
 from __future__ import annotations
 
 import json
-import os
-import subprocess
-import sys
 
 import httpx
 import pytest
+from tests.support.commands import servostudio
 from tests.support.motion_timing import InProcessServer
-
-
-def servostudio(*args: str, timeout: float = 120) -> subprocess.CompletedProcess:
-    command = [sys.executable, "-m", "servostudio", *args]
-    return subprocess.run(command, capture_output=True, text=True, timeout=timeout, env=dict(os.environ))
 
 
 @pytest.fixture(scope="module")

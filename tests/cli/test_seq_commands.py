@@ -6,7 +6,7 @@ from __future__ import annotations
 import json
 
 import pytest
-from tests.services.sequences.conftest import CONDITIONAL_JUMP, COUNTER_LOOP
+from tests.support.sequence_programs import CONDITIONAL_JUMP, COUNTER_LOOP
 
 from servostudio.cli import main
 from servostudio.drive.cia402 import State

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import json
 
-from tests.services.sequences.conftest import COUNTER_LOOP
+from tests.support.sequence_programs import COUNTER_LOOP
 
 from servostudio.cli import main
 

@@ -12,11 +12,7 @@ import can
 import canopen
 import pytest
 from canopen.sdo.exceptions import SdoAbortedError
-
-from servostudio.od.datatypes import DataType
-from servostudio.sim import sdo_abort
-
-from .recorder_peer import (
+from tests.support.recorder_peer import (
     ARM,
     AUTO,
     CURRENT,
@@ -50,6 +46,9 @@ from .recorder_peer import (
     sample_grid,
     scope_bus,
 )
+
+from servostudio.od.datatypes import DataType
+from servostudio.sim import sdo_abort
 
 I16, I32, U16 = DataType.INTEGER16, DataType.INTEGER32, DataType.UNSIGNED16
 POSITION_DEMAND, FOLLOWING_ERROR = (0x6062, 0), (0x60F4, 0)

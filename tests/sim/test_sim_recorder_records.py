@@ -5,11 +5,10 @@ from __future__ import annotations
 
 from hypothesis import given
 from hypothesis import strategies as st
+from tests.support.recorder_peer import decode_records
 
 from servostudio.od.datatypes import DataType, encode
 from servostudio.sim.drive.recording import FORMATS, pack_records, record_struct
-
-from .recorder_peer import decode_records
 
 
 def values_of(data_type: DataType) -> st.SearchStrategy:

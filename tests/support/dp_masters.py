@@ -7,6 +7,10 @@ from __future__ import annotations
 import contextlib
 from collections.abc import Iterator
 
+from servostudio.drive.access import Drive
+from servostudio.drive.profibus.engine import PkwEngine
+from servostudio.drive.profibus.link import ProfibusLink
+from servostudio.drive.profiles import profile_for
 from servostudio.od.pnu import builtin_parameter_list
 from servostudio.sim.plant import Plant
 from servostudio.sim.profibus.endpoints import ProfibusPty, ProfibusTcpServer
@@ -46,6 +50,19 @@ def dp_master(transport: str, line: ProfibusLine) -> Iterator[DpLine]:
             yield master
     finally:
         endpoint.stop()
+
+
+@contextlib.contextmanager
+def dp_drive(transport: str, line: ProfibusLine, address: int) -> Iterator[Drive]:
+    """The TTA-PRO at ``address`` as a `Drive` on the PKW engine, through a master of ``transport``."""
+    with dp_master(transport, line) as master:
+        parameters = builtin_parameter_list()
+        link = ProfibusLink("pb", master)
+        link.start()
+        try:
+            yield Drive(PkwEngine(link, lambda node: parameters), address, parameters, profile_for("ttapro"))
+        finally:
+            link.close()
 
 
 def _master(endpoint: ProfibusPty | ProfibusTcpServer) -> DpLine:

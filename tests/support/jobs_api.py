@@ -1,25 +1,60 @@
-"""The REST job tests' common steps (procedures, identification, frequency response): a live client that arms
-node 1 of the ``sim`` bus and releases it afterwards, and a job followed until it ends."""
+"""The REST tests' common steps of a live client (procedures, identification, frequency response, the quick test's
+motions, sequences): an axis armed over the client's event socket and released afterwards (or lost with the socket),
+the keepalives of a held motion, a condition waited for, and a job followed until it ends."""
 
 from __future__ import annotations
 
 import contextlib
+import threading
 import time
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 
 NODE = "/api/buses/sim/nodes/1"
 
 
 @contextlib.contextmanager
-def armed(client, node: str = NODE) -> Iterator[tuple[object, dict[str, str]]]:
-    """The event socket (progress and job events) of a client that armed the axis, and the header naming it."""
-    with client.websocket_connect("/api/ws/events?types=progress,job") as socket:
+def armed(
+    client, node: str = NODE, events: str = "progress,job", release: bool = True
+) -> Iterator[tuple[object, dict[str, str]]]:
+    """The event socket (subscribed to the ``events`` types) of a client that armed the axis, and the header naming
+    it. The axis is released on exit; with ``release=False`` it is not, so leaving closes the socket of its armed
+    controller: the controller is lost, as a closed browser tab loses it (what the controller-loss tests try)."""
+    with client.websocket_connect(f"/api/ws/events?types={events}") as socket:
         header = {"X-Servo-Client": socket.receive_json()["client"]}
         assert client.post(f"{node}/control/arm", headers=header).status_code == 200
         try:
             yield socket, header
         finally:
-            client.post(f"{node}/control/release", headers=header)
+            if release:
+                client.post(f"{node}/control/release", headers=header)
+
+
+@contextlib.contextmanager
+def holding(socket, bus: str, node: int) -> Iterator[None]:
+    """Keepalives of node ``node`` on ``bus`` every 20 ms from a thread of their own while the block runs, as a held
+    button sends them (also while the motion's request is on its way)."""
+    stop = threading.Event()
+
+    def send() -> None:
+        while not stop.wait(0.02):
+            socket.send_json({"type": "keepalive", "bus": bus, "node": node})
+
+    sender = threading.Thread(target=send, daemon=True)
+    sender.start()
+    try:
+        yield
+    finally:
+        stop.set()
+        sender.join()
+
+
+def eventually(condition: Callable[[], bool], timeout: float = 2.0) -> float:
+    """Seconds until ``condition`` held (fails after ``timeout``)."""
+    start = time.monotonic()
+    while not condition():
+        assert time.monotonic() - start < timeout, "the condition never held"
+        time.sleep(0.005)
+    return time.monotonic() - start
 
 
 def finished(client, job: str, timeout: float = 60.0) -> dict:

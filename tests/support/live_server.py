@@ -97,3 +97,9 @@ def _private_ui() -> list[str]:
     frontend change while others' browser tests read the shared build)."""
     built = os.environ.get("SERVOSTUDIO_TEST_UI")
     return ["--ui", built] if built else []
+
+
+def private_ui_settings() -> dict[str, Path]:
+    """The same for a server built in the test's process: ``Settings(**private_ui_settings(), …)``."""
+    built = os.environ.get("SERVOSTUDIO_TEST_UI")
+    return {"static_dir": Path(built)} if built else {}

@@ -17,12 +17,15 @@ from __future__ import annotations
 
 import threading
 import time
+from collections.abc import Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
 
+import httpx
 import uvicorn
 from tests.support.access import passwordless
-from tests.support.live_server import free_port
+from tests.support.live_server import free_port, private_ui_settings
 
 from servostudio.api.app import Settings, create_app
 from servostudio.sim.drive.statemachine import State
@@ -39,7 +42,11 @@ class InProcessServer:
         self.port = free_port()
         self.url = f"http://127.0.0.1:{self.port}"
         settings = Settings(
-            projects_dir=root / "projects", data_dir=passwordless(root / "data"), buses=("sim",), port=self.port
+            projects_dir=root / "projects",
+            data_dir=passwordless(root / "data"),
+            buses=("sim",),
+            port=self.port,
+            **private_ui_settings(),
         )
         (root / "projects").mkdir(exist_ok=True)
         self.app = create_app(settings)
@@ -65,6 +72,22 @@ class InProcessServer:
     def close(self) -> None:
         self.server.should_exit = True
         self.thread.join(timeout=15)
+
+    def open_bus(self, spec: str, bus_id: str) -> InProcessServer:
+        """Open ``spec`` as bus ``bus_id`` of the server (a simulated TTA-PRO line's, for example)."""
+        opened = httpx.post(f"{self.url}/api/buses", json={"spec": spec, "id": bus_id}, timeout=15)
+        assert opened.status_code == 201, opened.text
+        return self
+
+
+@contextmanager
+def server_on_bus(root: Path, spec: str, bus_id: str = "pb") -> Iterator[InProcessServer]:
+    """An in-process server with ``spec`` opened as bus ``bus_id``, closed on exit."""
+    running = InProcessServer(root)
+    try:
+        yield running.open_bus(spec, bus_id)
+    finally:
+        running.close()
 
 
 @dataclass

@@ -6,6 +6,7 @@ drive so that a backup holds every object.
 from __future__ import annotations
 
 import contextlib
+import time
 
 import pytest
 
@@ -152,3 +153,11 @@ def endpoint(request, sim_network):
     made = Socketcand(sim_network) if request.param == "socketcand" else SerialEndpoint(sim_network, quirk=True)
     yield made
     made.close()
+
+
+def wait_connected(connection, timeout: float = 15.0) -> None:
+    """Until the connection's link is back (after the endpoint was cut and restored)."""
+    deadline = time.monotonic() + timeout
+    while not connection.link.connected:
+        assert time.monotonic() < deadline, "the link did not come back"
+        time.sleep(0.05)

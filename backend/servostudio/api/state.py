@@ -56,4 +56,7 @@ class ServerState:
             self.connections.share(*parse_share(share))
 
     def close(self) -> None:
+        """Close every bus, then end the motion guard's threads (the hold-to-run watchdog stops what expires while
+        the buses close)."""
         self.connections.close_all()
+        self.motion.close()

@@ -1,4 +1,4 @@
-"""Drive commands: ``servostudio scan|read|write|backup|restore|nmt|fault|state|io --bus SPEC [--node N] …``.
+"""Drive commands: ``servostudio scan|read|write|backup|restore|store|nmt|fault|state|io --bus SPEC [--node N] …``.
 
 Through a running server (``--server URL``, ``$SERVOSTUDIO_SERVER`` or the config file: ``cli.remote``) each
 command is the server's REST calls (``cli.server_drive``); with ``--bus`` alone it opens the bus itself (headless).
@@ -34,6 +34,7 @@ from servostudio.services.backup import (
     restore_drive,
     restore_file,
     run_per_drive,
+    store_parameters,
 )
 from servostudio.services.bus import BusConnection
 from servostudio.services.motion import Axis, MotionGuard
@@ -93,6 +94,13 @@ def register(commands: argparse._SubParsersAction) -> None:
     )
     restore.add_argument("--in", dest="source", type=Path, required=True, help="file (one node) or directory")
     restore.add_argument("--no-store", action="store_true", help="do not store to flash afterwards")
+    add(
+        "store",
+        "store the drive's parameters in its non-volatile memory (the device's save: 0x1010,1 = 'save', a TTA-PRO's "
+        "PNU 729 = 1)",
+        _store,
+        server_drive.store,
+    )
     nmt = add("nmt", "send an NMT command", _nmt, server_drive.nmt, node="none")
     nmt.add_argument(
         "command_name", metavar="COMMAND", help="start, stop, pre-operational, reset-node, reset-communication"
@@ -245,6 +253,10 @@ def _restore(args: argparse.Namespace, connection: BusConnection) -> object:
     return _collect(
         run_per_drive(drives, lambda drive: restore_drive(drive, source / f"node{drive.node}", store=store))
     )
+
+
+def _store(args: argparse.Namespace, connection: BusConnection) -> object:
+    return store_parameters(_drive(args, connection))
 
 
 def _collect(results: dict[int, Sequence[FileResult] | Exception]) -> object:

@@ -190,6 +190,10 @@ def restore(args: argparse.Namespace, bus: ServerBus) -> object:
     return _collected(_per_node(nodes, one))
 
 
+def store(args: argparse.Namespace, bus: ServerBus) -> object:
+    return bus.call("POST", bus.path(args.node, f"/store{_device(args)}"))
+
+
 def _download(args: argparse.Namespace, bus: ServerBus, node: int, kind: FileKind, path: Path) -> dict[str, Any]:
     content, headers = bus.remote.exchange("GET", bus.path(node, f"/files/{kind.value}{_device(args)}"))
     write_text_atomic(path, content.decode(FILE_ENCODING))
@@ -214,8 +218,8 @@ def _nodes(args: argparse.Namespace, bus: ServerBus) -> list[tuple[int, str | No
     the server's bus finds."""
     if args.node:
         if not args.device:  # the server identifies a node on first use; one that does not answer fails here
-            for node in args.node:
-                bus.call("GET", bus.path(node, "/objects/0x1000"))
+            for node in args.node:  # by its semantic name: a PROFIBUS-DP drive has no 0x1000, every drive a status word
+                bus.call("GET", bus.path(node, "/objects/statusword"))
         known = {item["node"]: item.get("device") for item in bus.call("GET", bus.path())["nodes"]}
         return [(node, args.device or known.get(node)) for node in args.node]
     found, hint = _scanned(bus)

@@ -22,6 +22,8 @@ would mix values from before and after it.
 
 Every transfer ends by itself — answer, abort, timeout, link lost, bus closed — so a future never stays pending;
 waits on futures are still bounded (`settle`, `TransferBatch.outcomes`), as a safety net against a stuck reader.
+The futures, the batches, the bounded wait and a node's two lanes are ``drive/transfers.py``'s, shared with the PKW
+engine; `settle`, `SAFETY_WAIT` and `OutcomeOverdue` are re-exported here, where the engine's callers take them.
 
 Large objects (the recorder's buffer, any DOMAIN of kilobytes) are read by block upload (`upload_block`,
 ``drive/sdo_block.py``): a block of up to 127 segments per acknowledgement instead of a request per 7 bytes. A node
@@ -41,11 +43,15 @@ import time
 from collections import deque
 from collections.abc import Callable, Sequence
 from concurrent.futures import CancelledError, Future
-from typing import Any, Generic, TypeVar
+from typing import TypeVar
 
 from servostudio.drive.abort_codes import abort_text
 from servostudio.drive.link import BusLink, LinkDownError
 from servostudio.drive.sdo_block import MAX_BLOCK_SIZE, SEGMENT_BYTES, BlockProtocolError, BlockUpload, Step
+from servostudio.drive.transfers import SAFETY_WAIT as SAFETY_WAIT
+from servostudio.drive.transfers import Completion, FutureCompletion, NodeLanes, TransferBatch
+from servostudio.drive.transfers import OutcomeOverdue as OutcomeOverdue
+from servostudio.drive.transfers import settle as settle
 from servostudio.errors import CommunicationError, Conflict, Timeout, Unavailable
 
 log = logging.getLogger(__name__)
@@ -54,9 +60,6 @@ SDO_REQUEST = 0x600
 SDO_RESPONSE = 0x580
 BOOT_UP = 0x700  # + node: the error-control message whose single byte 0 says the node (re)started
 DEFAULT_TIMEOUT = 0.5
-#: Safety net of every wait on a transfer: the engine ends each transfer itself, but a transfer may wait behind
-#: many queued ones of its node, and a stuck reader thread must not hang a request or a job for ever.
-SAFETY_WAIT = 120.0
 UPLOAD_RETRIES = 1  # a read has no side effect: one lost frame should not fail a 400-object backup
 ABORT_TIMEOUT = 0x05040000
 ABORT_COMMAND = 0x05040001
@@ -68,10 +71,6 @@ _LISTEN = b""
 PROGRESS_SEGMENTS = MAX_BLOCK_SIZE
 #: Safety net of the wait on one large upload: 32 KB by segmented SDO over the 19200-baud RS-232 link take 2 minutes
 LARGE_SAFETY_WAIT = 600.0
-
-#: What a transfer ends with before conversion: the bytes read, or None for a write. The transfer's direction
-#: decides which, so the completions (shared by both directions) take either; the public methods say which.
-_Result = Any
 R = TypeVar("R")
 
 
@@ -110,108 +109,6 @@ class SdoNodeRestarted(SdoError):
     """The node sent its boot-up message while the transfer was in progress or queued: it was reset or power-cycled."""
 
 
-class OutcomeOverdue(Timeout):
-    """A transfer's outcome did not arrive within the safety bound of the wait (the bus reader is stuck)."""
-
-
-def settle(future: Future[R], seconds: float = SAFETY_WAIT) -> R:
-    """The result of a transfer's future, waiting at most ``seconds``; the one bounded wait of the product."""
-    try:
-        return future.result(seconds)
-    except TimeoutError:
-        raise OutcomeOverdue(f"no outcome of the transfer within {seconds:.0f} s; the bus reader is stuck") from None
-
-
-class _FutureCompletion:
-    """The outcome of one transfer goes to a future (after ``convert`` of a successful result)."""
-
-    __slots__ = ("convert", "future")
-
-    def __init__(self, convert: Callable[[_Result], object] | None) -> None:
-        self.future: Future[object] = Future()
-        self.convert = convert
-
-    def start(self, slot: int) -> bool:
-        return self.future.set_running_or_notify_cancel()  # from now on cancel() refuses: the outcome is known
-
-    def drive_silent(self) -> None:
-        """Nothing more to drop: the transfer itself ends with its timeout."""
-
-    def done(self, slot: int, outcome: _Result | Exception) -> None:
-        if self.future.done():
-            return
-        if not isinstance(outcome, Exception) and self.convert is not None:
-            try:
-                outcome = self.convert(outcome)
-            except Exception as error:  # noqa: BLE001 -- the caller gets any error of convert (ValueError: no value)
-                outcome = error
-        if isinstance(outcome, Exception):
-            self.future.set_exception(outcome)
-        else:
-            self.future.set_result(outcome)
-
-
-class TransferBatch(Generic[R]):
-    """Reads (or writes) of many objects of one node with one future for all: ``future`` gives a list, in request
-    order, of each result — the bytes read or None for a write, passed through ``convert(position, result)`` when
-    given — or the exception that ended that transfer.
-
-    A backup reads hundreds of objects; one future per object would cost more client time than the frames.
-    ``on_each(position, outcome)`` runs as each transfer ends (on the bus reader thread: keep it short).
-    ``cancel()`` drops the transfers not yet sent; their outcome is a ``CancelledError``. A transfer that times out
-    drops the rest the same way: a drive that stopped answering would otherwise cost a timeout per object.
-    """
-
-    def __init__(
-        self,
-        count: int,
-        convert: Callable[[int, _Result], R] | None = None,
-        on_each: Callable[[int, R | Exception], None] | None = None,
-    ) -> None:
-        self.future: Future[list[R | Exception]] = Future()
-        self.future.set_running_or_notify_cancel()
-        self.patience = SAFETY_WAIT  # the engine adds the time its own transfers may take
-        self._outcomes: list[Any] = [None] * count  # every slot is filled before the future completes
-        self._left = count
-        self._convert = convert
-        self._on_each = on_each
-        self._cancelled = False
-        self._lock = threading.Lock()
-        if count == 0:
-            self.future.set_result([])
-
-    def outcomes(self) -> list[R | Exception]:
-        """Wait for every transfer of the batch (bounded by ``patience``) and give their outcomes."""
-        return settle(self.future, self.patience)
-
-    def cancel(self) -> None:
-        self._cancelled = True
-
-    def start(self, slot: int) -> bool:
-        return not self._cancelled
-
-    def drive_silent(self) -> None:
-        """A transfer timed out: the drive stopped answering, the transfers still queued are dropped."""
-        self._cancelled = True
-
-    def done(self, slot: int, outcome: _Result | Exception) -> None:
-        if not isinstance(outcome, Exception) and self._convert is not None:
-            try:
-                outcome = self._convert(slot, outcome)
-            except Exception as error:  # noqa: BLE001 -- the caller gets any error of convert (ValueError: no value)
-                outcome = error
-        with self._lock:
-            self._outcomes[slot] = outcome
-            self._left -= 1
-            last = self._left == 0
-        try:
-            if self._on_each is not None:
-                self._on_each(slot, outcome)
-        finally:  # a failing callback must not leave the caller waiting forever
-            if last:
-                self.future.set_result(self._outcomes)
-
-
 class _Transfer:
     """One SDO transfer and where its state machine stands."""
 
@@ -246,7 +143,7 @@ class _Transfer:
         index: int,
         sub: int,
         timeout: float,
-        completion: _FutureCompletion | TransferBatch[Any],
+        completion: Completion,
         slot: int = 0,
         download: bytes | None = None,
         abort_on_timeout: bool = True,
@@ -283,31 +180,6 @@ class _Transfer:
         return len(self.block.received) if self.block is not None else len(self.received)
 
 
-class _NodeQueue:
-    """A node's waiting transfers in two lanes: what someone waits for interactively goes ahead of bulk work, each
-    lane in the order it was queued."""
-
-    __slots__ = ("bulk", "interactive")
-
-    def __init__(self) -> None:
-        self.interactive: deque[_Transfer] = deque()
-        self.bulk: deque[_Transfer] = deque()
-
-    def add(self, transfers: list[_Transfer], bulk: bool) -> None:
-        (self.bulk if bulk else self.interactive).extend(transfers)
-
-    def next(self) -> _Transfer | None:
-        lane = self.interactive or self.bulk
-        return lane.popleft() if lane else None
-
-    def drain(self) -> list[_Transfer]:
-        """Every waiting transfer, taken out of the queue (the link is gone)."""
-        waiting = [*self.interactive, *self.bulk]
-        self.interactive.clear()
-        self.bulk.clear()
-        return waiting
-
-
 def _stale(transfer: _Transfer, data: bytes) -> bool:
     """An answer that belongs to an earlier request: a late reply about another object (after a timeout), or a
     second reply to a repeated initiate request while the segments are already running."""
@@ -338,7 +210,7 @@ class SdoEngine:
         self.link = link
         self.timeout = timeout
         self._lock = threading.RLock()  # futures' callbacks may submit the next transfer
-        self._queues: dict[int, _NodeQueue] = {}
+        self._queues: dict[int, NodeLanes[_Transfer]] = {}
         self._active: dict[int, _Transfer] = {}
         self._finished: deque[tuple[_Transfer, object]] = deque()  # outcomes to hand over once the lock is free
         self._reports: deque[tuple[Callable[[int, int | None], None], int, int | None]] = deque()  # progress
@@ -364,7 +236,7 @@ class SdoEngine:
         link 127 useless abort frames would cost most of a second.  ``bulk`` queues it behind interactive requests,
         as part of a long operation.
         """
-        completion = _FutureCompletion(convert)
+        completion = FutureCompletion(convert)
         self._submit(
             [
                 _Transfer(
@@ -390,9 +262,8 @@ class SdoEngine:
         on_each: Callable[[int, R | Exception], None] | None = None,
     ) -> TransferBatch[R]:
         """Read many objects of one node, back to back, in order, with one future for all (see `TransferBatch`)."""
-        batch = TransferBatch(len(objects), convert, on_each)
         timeout = timeout or self.timeout
-        batch.patience += len(objects) * timeout * (1 + UPLOAD_RETRIES)
+        batch = TransferBatch(len(objects), convert, on_each, each=timeout * (1 + UPLOAD_RETRIES))
         self._submit(
             [
                 _Transfer(node, index, sub, timeout, batch, slot, retries=UPLOAD_RETRIES)
@@ -420,7 +291,7 @@ class SdoEngine:
         """
         if not 1 <= block_size <= MAX_BLOCK_SIZE:
             raise ValueError(f"block size {block_size} outside 1..{MAX_BLOCK_SIZE}")
-        completion = _FutureCompletion(None)
+        completion = FutureCompletion(None)
         transfer = _Transfer(node, index, sub, timeout or self.timeout, completion, retries=UPLOAD_RETRIES)
         self._submit([transfer.large(0 if node in self._no_block else block_size, progress, stop)], bulk)
         return completion.future
@@ -436,9 +307,8 @@ class SdoEngine:
         """Write many objects of one node, back to back, in order, with one future for all (see `TransferBatch`)."""
         if any(not data for _, _, data in writes):
             raise ValueError("an SDO download needs at least one byte")
-        batch = TransferBatch(len(writes), convert, on_each)
         timeout = timeout or self.timeout
-        batch.patience += len(writes) * timeout
+        batch = TransferBatch(len(writes), convert, on_each, each=timeout)
         self._submit(
             [
                 _Transfer(node, index, sub, timeout, batch, slot, download=bytes(data))
@@ -462,7 +332,7 @@ class SdoEngine:
         part of a long operation, behind interactive requests)."""
         if not data:
             raise ValueError("an SDO download needs at least one byte")
-        completion = _FutureCompletion(convert)
+        completion = FutureCompletion(convert)
         self._submit([_Transfer(node, index, sub, timeout or self.timeout, completion, download=bytes(data))], bulk)
         return completion.future
 
@@ -476,7 +346,7 @@ class SdoEngine:
             raise ValueError(f"node ID {node} outside 1..127")
         with self._lock:
             if node not in self._queues:
-                self._queues[node] = _NodeQueue()
+                self._queues[node] = NodeLanes()
                 self.link.subscribe(SDO_RESPONSE + node, self._on_response)
                 self.link.subscribe(BOOT_UP + node, self._on_error_control)
             self._queues[node].add(transfers, bulk)

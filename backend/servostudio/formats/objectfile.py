@@ -53,8 +53,14 @@ class ObjectFileError(InvalidInput):
         self.reason = reason
 
 
-def parse_object_file(text: str, file: str = "<string>", validate: EntryValidator | None = None) -> list[ObjectEntry]:
-    """Parse object-file text into its entries, in file order; raise ObjectFileError on the first bad line."""
+def parse_object_file(
+    text: str,
+    file: str = "<string>",
+    validate: EntryValidator | None = None,
+    spelled: Callable[[int, int], str] | None = None,
+) -> list[ObjectEntry]:
+    """Parse object-file text into its entries, in file order; raise ObjectFileError on the first bad line.
+    ``spelled`` names an address in messages (default ``0xIIII,sub``)."""
     entries: list[ObjectEntry] = []
     first_line: dict[tuple[int, int], int] = {}
     for number, raw in enumerate(split_lines(text), start=1):
@@ -67,7 +73,9 @@ def parse_object_file(text: str, file: str = "<string>", validate: EntryValidato
         key = (entry.index, entry.sub)
         if key in first_line:
             raise ObjectFileError(
-                file, number, f"duplicate assignment of {_key_text(*key)} (first at line {first_line[key]})"
+                file,
+                number,
+                f"duplicate assignment of {(spelled or _key_text)(*key)} (first at line {first_line[key]})",
             )
         first_line[key] = number
         reason = validate(entry) if validate is not None else None

@@ -11,7 +11,7 @@ docs/profibus.md §10.
 from __future__ import annotations
 
 import os
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable
 
 from servostudio.formats.objectfile import EntryValidator, ObjectEntry, format_object_file, parse_object_file
 from servostudio.formats.textfile import split_lines, write_text_atomic
@@ -51,15 +51,26 @@ def parse_parameter_file(
             return validate(entry)
         return problem
 
-    return parse_object_file(text, file, checked)
+    return parse_object_file(text, file, checked, spelled=lambda pnu, ind: f"PNU {pnu},{ind}")
 
 
-def format_parameter_file(entries: Iterable[ObjectEntry], header: str | None = None) -> str:
-    """The canonical text: header comments, then ``PNU,IND=value`` in decimal sorted by (PNU, IND); ValueError for an
-    entry the reader would refuse."""
+def by_pnu(entry: ObjectEntry) -> tuple[int, int]:
+    return entry.index, entry.sub
+
+
+def by_ind(entry: ObjectEntry) -> tuple[int, int]:
+    """IND first: the lines of one sequence of a sequence table (IND = its number) stand together."""
+    return entry.sub, entry.index
+
+
+def format_parameter_file(
+    entries: Iterable[ObjectEntry], header: str | None = None, order: Callable[[ObjectEntry], tuple[int, int]] = by_pnu
+) -> str:
+    """The canonical text: header comments, then ``PNU,IND=value`` in decimal sorted by ``order`` ((PNU, IND) by
+    default); ValueError for an entry the reader would refuse."""
     lines = [f"; {text}" if text.strip() else ";" for text in split_lines(header)] if header else []
     previous: tuple[int, int] | None = None
-    for entry in sorted(entries, key=lambda item: (item.index, item.sub)):
+    for entry in sorted(entries, key=order):
         problem = _problem(entry) or ("assigned twice" if (entry.index, entry.sub) == previous else None)
         if problem is not None:
             raise ValueError(f"PNU {entry.index},{entry.sub}: {problem}")

@@ -34,6 +34,7 @@ from servostudio.drive.access import Drive, DriveAccessError
 from servostudio.drive.cia402 import State, decode_state
 from servostudio.drive.object_values import ObjectValue
 from servostudio.drive.profiles import DeviceProfile
+from servostudio.drive.profiles.base import ProcedureAfterChange
 from servostudio.drive.sdo import SAFETY_WAIT, SdoAbortError, SdoError, TransferBatch, settle
 from servostudio.errors import CommunicationError, InvalidInput, RefusedForSafety, ServoStudioError
 from servostudio.formats.objectfile import ObjectEntry, ObjectFileError
@@ -41,7 +42,8 @@ from servostudio.formats.parameterfile import format_drive_file, parse_drive_fil
 from servostudio.formats.sequence import SequenceFileError, SequenceTable, parse_sequence_text, write_sequence_file
 from servostudio.formats.textfile import FILE_ENCODING, write_text_atomic
 from servostudio.od.datatypes import DataType
-from servostudio.od.model import SaveType, Variable
+from servostudio.od.model import ObjectDictionary, SaveType, Variable
+from servostudio.services import sequence_buffer
 from servostudio.services.cancel import Cancellation, Cancelled
 
 log = logging.getLogger(__name__)
@@ -56,6 +58,7 @@ class FileKind(enum.StrEnum):
     USER_PAR = "USER_PAR.TXT"
     SEQUENCE = "SEQUENCE.TXT"
     TTAPAR = "TTAPAR.TXT"
+    TTASEQ = "TTASEQ.TXT"
 
     @classmethod
     def from_path(cls, path: Path) -> FileKind:
@@ -155,16 +158,20 @@ class RestoreResult:
 # ---------------------------------------------------------------------------------------------------- backup --
 def backup_objects(drive: Drive, save_type: SaveType) -> list[Variable]:
     """Objects of a save type that a restore can write back (readable and writable)."""
-    if drive.dictionary is None:
-        raise BackupError(f"node {drive.node}: no object dictionary known for this drive; scan the bus first")
     return [
         var
-        for var in drive.dictionary.variables()
+        for var in _dictionary(drive).variables()
         if var.save_type is save_type
         and var.access.readable
         and var.access.writable
         and var.data_type not in (DataType.DOMAIN, DataType.OCTET_STRING)
     ]
+
+
+def _dictionary(drive: Drive) -> ObjectDictionary:
+    if drive.dictionary is None:
+        raise BackupError(f"node {drive.node}: no object dictionary known for this drive; scan the bus first")
+    return drive.dictionary
 
 
 def _make_folder(folder: Path, what: str) -> None:
@@ -194,7 +201,10 @@ def backup_file(
         table = _read_sequences(drive, progress)
         write_sequence_file(path, table, header=_header(drive, kind))
         return BackupResult(drive.node, str(path), kind.value, len(table), seconds=time.monotonic() - started)
-    assert kind.save_type is not None  # every file but SEQUENCE.TXT holds objects of one save type
+    if kind is FileKind.TTASEQ:
+        count = _back_up_sequence_buffer(drive, path, progress)
+        return BackupResult(drive.node, str(path), kind.value, count, seconds=time.monotonic() - started)
+    assert kind.save_type is not None  # every other file holds objects of one save type
     variables = backup_objects(drive, kind.save_type)
     values, skipped = _read_all(drive, variables, kind, progress, cancel)
     entries = []
@@ -310,9 +320,8 @@ def restore_drive(
     Files not started when a cancellation comes are left out of the result."""
     chosen = list(kinds or [kind for kind in drive_file_kinds(drive) if (directory / kind.value).is_file()])
     if not chosen:
-        raise RestoreValidationError(
-            f"node{drive.node}/: no DRIVEPAR.TXT, USER_PAR.TXT or SEQUENCE.TXT for node {drive.node}"
-        )
+        names = ", ".join(kind.value for kind in drive_file_kinds(drive))
+        raise RestoreValidationError(f"node{drive.node}/: none of {names} for node {drive.node}")
     results = []
     for kind in chosen:
         if cancel is not None and cancel.requested:
@@ -330,6 +339,8 @@ def profile_file_kinds(profile: DeviceProfile) -> list[FileKind]:
     kinds = [FileKind(name) for name in profile.parameter_files]
     if profile.has_sequences and profile.has("sequence_parameters"):
         kinds.append(FileKind.SEQUENCE)
+    if profile.sequence_buffer is not None:
+        kinds.append(FileKind(profile.sequence_buffer.file))
     return kinds
 
 
@@ -422,6 +433,8 @@ def restore_text(
     stored).  A sequence file is written whole once started (half a sequence memory is worth nothing)."""
     started = time.monotonic()
     result = RestoreResult(drive.node, file or kind.value, kind.value)
+    if kind is FileKind.TTASEQ:
+        return _restore_sequence_buffer(drive, text, Path(file).name if file else kind.value, result, progress, cancel)
     if kind is FileKind.SEQUENCE:
         table, writes = _validated_sequence_writes(drive, text)
     else:
@@ -442,7 +455,7 @@ def restore_text(
         if kind is FileKind.SEQUENCE:
             result.outcomes = _write_sequences(drive, table, writes, progress)
         else:
-            _write_and_verify(drive, writes, kind, progress, result.outcomes, cancel)
+            _write_with_procedures(drive, writes, kind, progress, result.outcomes, cancel)
         if store and all(outcome.status == "verified" for outcome in result.outcomes):
             procedure = "save_sequences" if kind is FileKind.SEQUENCE else "save"
             drive.start_procedure(procedure, timeout=SAVE_TIMEOUT)
@@ -464,6 +477,71 @@ def _in_restore_order(drive: Drive, writes: list[tuple[Variable, object]]) -> li
 
 def _rank(first: list[tuple[int, int]], address: tuple[int, int]) -> int:
     return first.index(address) if address in first else len(first)
+
+
+def _write_with_procedures(
+    drive: Drive,
+    writes: list[tuple[Variable, object]],
+    kind: FileKind,
+    progress: Progress | None,
+    report: list[ObjectOutcome],
+    cancel: Cancellation | None,
+) -> None:
+    """Write and verify the file's objects; a procedure the profile needs after a change (the TTA-PRO's feedback
+    programming, PNU 894, after 890-893/898) runs right after its objects — only when this restore changes one of
+    them against what the drive held before, and they all verified — and the rest of the file follows."""
+    due = [after for after in drive.profile.procedures_after_change if _changes(drive, writes, after)]
+    split = max((_after_last(drive, writes, after) for after in due), default=len(writes))
+    _write_and_verify(drive, writes[:split], kind, progress, report, cancel)
+    if due and all(outcome.status == "verified" for outcome in report):
+        for after in due:
+            _run_after_change(drive, after)
+    if writes[split:]:
+        _write_and_verify(drive, writes[split:], kind, progress, report, cancel)
+
+
+def _procedure_addresses(drive: Drive, after: ProcedureAfterChange) -> set[tuple[int, int]]:
+    return {drive.profile.address(name) for name in after.objects}
+
+
+def _changes(drive: Drive, writes: list[tuple[Variable, object]], after: ProcedureAfterChange) -> bool:
+    """The file sets one of the procedure's objects to a value the drive does not hold now (read before writing)."""
+    addresses = _procedure_addresses(drive, after)
+    return any(var.key in addresses and not _same(drive.read(var).raw, value) for var, value in writes)
+
+
+def _after_last(drive: Drive, writes: list[tuple[Variable, object]], after: ProcedureAfterChange) -> int:
+    addresses = _procedure_addresses(drive, after)
+    return 1 + max(position for position, (var, _) in enumerate(writes) if var.key in addresses)
+
+
+def _run_after_change(drive: Drive, after: ProcedureAfterChange) -> None:
+    try:
+        drive.start_procedure(after.procedure, timeout=after.timeout)
+    except SdoError as error:
+        raise BackupError(
+            f"restore of node {drive.node} stopped: {after.procedure} after {', '.join(after.objects)} failed: "
+            f"{error}; the rest of the file was not written, nothing was stored to flash"
+        ) from None
+
+
+def store_parameters(drive: Drive) -> dict[str, object]:
+    """Store the values the drive holds now in its non-volatile memory, so that they survive a power cycle: the
+    profile's ``save`` procedure (0x1010,1 = 'save' on the CANopen drives, PNU 729 = 1 on a TTA-PRO).  A device that
+    saves only while disabled is refused enabled, before anything is written."""
+    started = time.monotonic()
+    action = store_action(drive.profile, _dictionary(drive))
+    _check_can_store(drive, True)
+    drive.start_procedure("save", timeout=SAVE_TIMEOUT)
+    return {"node": drive.node, "stored": "save", "wrote": action, "seconds": round(time.monotonic() - started, 3)}
+
+
+def store_action(profile: DeviceProfile, od: ObjectDictionary) -> str:
+    """What storing writes on a device, in its dictionary's words (``PNU 729 Save parameters = 1``,
+    ``0x1010,1 Store parameters.… = 'save'``): the UI says it before the click, the result after it."""
+    address, value = profile.signature("save")
+    signature = None if "save" in profile.procedure_values else profile.signatures.get("save")
+    return f"{od[address].label} = {repr(signature[1]) if signature else value}"
 
 
 def _check_can_store(drive: Drive, store: bool) -> None:
@@ -669,6 +747,66 @@ def _write_sequences(
             )
         )
     return outcomes
+
+
+# ------------------------------------------------------------------------------- sequences behind a buffer --
+def _back_up_sequence_buffer(drive: Drive, path: Path, progress: Progress | None) -> int:
+    """TTASEQ.TXT: the sequences in use, read through the drive's buffer; the number of sequences."""
+    buffer = sequence_buffer.buffer_of(drive)
+    reporter = _Reporter(progress, "backup", drive.node, buffer.file, buffer.count)
+    try:
+        table = sequence_buffer.read_table(drive, reporter.step)
+    except SdoError as error:
+        raise BackupError(f"backup of node {drive.node} ({buffer.file}) stopped, no file written: {error}") from None
+    reporter.finish()
+    write_text_atomic(path, sequence_buffer.format_table(drive.profile, table, _header(drive, FileKind(buffer.file))))
+    return len(table)
+
+
+def _restore_sequence_buffer(
+    drive: Drive, text: str, name: str, result: RestoreResult, progress: Progress | None, cancel: Cancellation | None
+) -> RestoreResult:
+    """Validate the whole file, then write the whole table (the sequences not listed are cleared), verify it, and
+    store the checksum — only once every sequence verified: a table left half-written keeps the old checksum, so
+    the drive reports it (an EEPROM sequence checksum fault) at its next power-up instead of running it."""
+    started = time.monotonic()
+    try:
+        table = sequence_buffer.parse_table(drive.profile, _dictionary(drive), text, name)
+    except sequence_buffer.SequenceTableInvalid as error:
+        raise RestoreValidationError(f"{error} — nothing was written to node {drive.node}") from None
+    _check_can_store(drive, True)
+    if cancel is not None and cancel.requested:
+        result.error, result.cancelled = f"restore of node {drive.node} cancelled: nothing was written", True
+        return result
+    reporter = _Reporter(progress, "restore", drive.node, result.kind, sequence_buffer.buffer_of(drive).count)
+    try:
+        held = sequence_buffer.write_table(drive, table, reporter.step)
+    except SdoError as error:
+        result.error = f"restore of node {drive.node} stopped: {error}. {_UNCHECKED}"
+    else:
+        result.outcomes = _sequence_outcomes(table, held)
+        differ = sum(1 for difference in held.values() if difference)
+        if differ:
+            result.error = f"node {drive.node}: {differ} sequences differ from the file. {_UNCHECKED}"
+        else:
+            result.stored = sequence_buffer.store_checksum(drive)
+    result.seconds = time.monotonic() - started
+    return result
+
+
+_UNCHECKED = (
+    "The sequence checksum was not updated: the drive reports an EEPROM sequence checksum fault at its next "
+    "power-up until a restore of the table completes."
+)
+
+
+def _sequence_outcomes(table: sequence_buffer.Table, held: dict[int, str]) -> list[ObjectOutcome]:
+    """One outcome per sequence written or cleared: "in use" or "unused" as the file has it."""
+    return [
+        ObjectOutcome(f"sequence {number}", "in use" if number in table else "unused",
+                      "failed" if difference else "verified", difference)
+        for number, difference in held.items()
+    ]  # fmt: skip
 
 
 # ------------------------------------------------------------------------------------------------- helpers --

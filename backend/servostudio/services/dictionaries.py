@@ -5,11 +5,15 @@ from __future__ import annotations
 
 import os
 import tempfile
+from collections.abc import Callable
 from pathlib import Path
 
+from servostudio.drive.profiles import DeviceProfile, ProfileError, profile_for
 from servostudio.errors import InvalidInput, NotFound
 from servostudio.od import EdsLibrary, LibraryError, ObjectDictionary, Variable, load_dictionary
 from servostudio.od.ini import decode_ini
+from servostudio.services import backup
+from servostudio.services.backup import profile_file_kinds
 
 
 class UnknownDictionary(NotFound):
@@ -38,6 +42,54 @@ def entry(od: ObjectDictionary, key: str) -> Variable:
         return od.find(key)
     except KeyError as error:
         raise UnknownEntry(error.args[0]) from None
+
+
+def profile_names(od: ObjectDictionary) -> dict[str, tuple[int, int]]:
+    """The semantic names of the device's profile that its dictionary has, with their addresses: a client (the
+    dashboard) asks for ``statusword`` or ``position_actual`` and learns this device's address — 0x6041 on a
+    CANopen drive, the PZD status word on a TTA-PRO — instead of keeping a table of raw addresses of its own."""
+    objects = profile_for(od.device).objects
+    return {name: address for name, address in sorted(objects.items()) if address in od}
+
+
+def fieldbus(od: ObjectDictionary) -> str:
+    """The device's fieldbus (``CANopen``, ``PROFIBUS-DP``): what a client may offer (NMT, modes of operation)."""
+    return profile_for(od.device).fieldbus
+
+
+def drive_files(od: ObjectDictionary) -> list[str]:
+    """The files a backup of the device holds (its profile's: DRIVEPAR.TXT …, a TTA-PRO's TTAPAR.TXT, TTASEQ.TXT)."""
+    return [kind.value for kind in profile_file_kinds(profile_for(od.device))]
+
+
+#: what a client may offer a device, each by the part of its profile the server's service needs (and refuses
+#: without): captures need CANopen's TPDOs or recorder; a measured frequency response those and the speed loop
+FEATURES: dict[str, Callable[[DeviceProfile], bool]] = {
+    "scope": lambda profile: profile.canopen,
+    # the procedure pages, each by the procedure it starts (a CD1-k phases and auto-tunes but has no 'calc')
+    "current_loop": lambda profile: profile.procedures.get("current_loop") is not None,
+    "phasing": lambda profile: profile.procedures.get("auto_phasing") is not None,
+    "auto_tuning": lambda profile: profile.procedures.get("auto_tuning") is not None,
+    "frequency_response": lambda profile: profile.canopen and profile.speed_loop is not None,
+    "sequences": lambda profile: profile.has_sequences,
+    "io": lambda profile: profile.io is not None,
+}
+
+
+def features(od: ObjectDictionary) -> list[str]:
+    """The services the device has (``FEATURES``): the UI shows only the pages a device can use, from this answer
+    instead of a list of device names of its own."""
+    profile = profile_for(od.device)
+    return [name for name, has in FEATURES.items() if has(profile)]
+
+
+def store_action(od: ObjectDictionary) -> str | None:
+    """What "store parameters" writes on the device (``PNU 729 Save parameters in EEPROM = 1``); None when its
+    profile or dictionary has no save."""
+    try:
+        return backup.store_action(profile_for(od.device), od)
+    except (ProfileError, KeyError):
+        return None
 
 
 def is_builtin(library: EdsLibrary, device: str) -> bool:

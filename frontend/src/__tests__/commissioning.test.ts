@@ -10,7 +10,7 @@ function sub(subindex: number, access = "rw", save_type = "DRIVEPAR"): OdVariabl
 }
 
 const dictionary: Dictionary = {
-  device: "t", product_name: "T", vendor_id: 0, product_code: 0, revision: 0, groups: [], builtin: true, object_count: 3,
+  device: "t", product_name: "T", vendor_id: 0, product_code: 0, revision: 0, groups: [], builtin: true, object_count: 3, names: {}, fieldbus: "CANopen", files: ["DRIVEPAR.TXT"], features: [], store: null,
   objects: [
     { index: 0x6073, name: "Max current", kind: "VAR", group: "Motor", subs: [sub(0)] },
     { index: 0x6075, name: "Rated current", kind: "VAR", group: "Motor", subs: [sub(0)] },

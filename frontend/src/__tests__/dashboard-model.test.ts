@@ -28,7 +28,9 @@ vi.mock("../components/ui", () => ({ toast: vi.fn(), errorText: (error: unknown)
 
 const statusword = entry(0x6041, { name: "Statusword", access: "ro" });
 const voltage = entry(0x6079, { name: "DC link circuit voltage", access: "ro", unit: "V" });
-const dictionary = { groups: [], objects: [statusword.object, voltage.object] } as unknown as Dictionary;
+const dictionary = {
+  groups: [], objects: [statusword.object, voltage.object], names: { statusword: [0x6041, 0], dc_link_voltage: [0x6079, 0] }, fieldbus: "CANopen", files: ["DRIVEPAR.TXT"],
+} as unknown as Dictionary;
 const noFaults = { faults: [], warnings: [], fault: false, error_code: 0, error_text: "" };
 
 function model(shown: Dictionary = dictionary) {
@@ -105,7 +107,7 @@ describe("dashboard model", () => {
   it("writes mode, ramps and target for the quick test, and target 0 on stop", async () => {
     const dictionaryWithTest = { groups: [], objects: [
       entry(0x6060, { data_type: "INTEGER8" }).object, entry(0x60ff, { data_type: "INTEGER32" }).object,
-    ] } as unknown as Dictionary;
+    ], names: { modes_of_operation: [0x6060, 0], target_velocity: [0x60ff, 0] } } as unknown as Dictionary;
     const { model: dashboard, signals } = model(dictionaryWithTest);
     api.read.mockResolvedValue({ raw: 900 });
     const target = dashboard.quickValue(signals.targetVelocity!);

@@ -21,7 +21,7 @@ const mode = entry(0x6060, { name: "Modes of operation", data_type: "INTEGER8", 
 function control(overrides: Partial<DeviceControlProps> = {}) {
   const props = {
     statusword: state<number | null>(null), reachable: state(true), busy: state(false), armed: state(true), nmt: state("NMT OPERATIONAL"),
-    connection: state(""), mode, activeMode: state<Scalar>(3), activeModeText: state("Profile velocity (3)"),
+    connection: state(""), mode, nmtCommands: true, modes: true, activeMode: state<Scalar>(3), activeModeText: state("Profile velocity (3)"),
     onCommand: vi.fn(), onSetMode: vi.fn(), onNmt: vi.fn(), ...overrides,
   };
   return { props, element: deviceControl(props) };
@@ -95,6 +95,14 @@ describe("device control", () => {
     expect(select.value).toBe("1");
     click(testid(element, "dashboard-set-mode"));
     expect(props.onSetMode).toHaveBeenCalledWith(1, "Profile position (1)");
+  });
+
+  it("offers no NMT commands and no mode of operation to a device without them (PROFIBUS-DP)", () => {
+    const { element } = control({ nmtCommands: false, modes: false, mode: null });
+    expect(testid(element, "dashboard-nmt-commands")).toBeNull();
+    expect(testid(element, "dashboard-mode")).toBeNull();
+    expect(element.textContent).not.toContain("Mode of operation");
+    expect(testid(control().element, "dashboard-nmt-commands")!.querySelectorAll("button")).toHaveLength(4);
   });
 
   it("binds the NMT state and the live connection", () => {
@@ -196,6 +204,15 @@ describe("measurements", () => {
     expect([value.textContent, value.title]).toEqual(["error", "SDO timeout"]);
     expect(testid(element, "readout-0x6079,0")!.textContent).toContain("DC link circuit voltage");
   });
+
+  it("shows a current monitor at a readable precision, not ten digits", () => {
+    const scaled = entry(0x3000, { name: "Current monitor", data_type: "INTEGER16", unit: "A", scale: 0.0061038881767686015, access: "ro" });
+    const real = entry(0x3001, { name: "Current", data_type: "REAL32", unit: "A", access: "ro" });
+    const cells = new Map<Entry, State<LiveCell>>([[scaled, state<LiveCell>(sample(127))], [real, state<LiveCell>(sample(0.7782819016))]]);
+    const element = measurementsPanel({ entries: [scaled, real], cell: (item) => cells.get(item)!.val, address: (item) => item.key });
+    const shown = (item: Entry) => testid(element, `readout-${item.key}`)!.querySelector<HTMLElement>(".value")!.textContent;
+    expect([shown(scaled), shown(real)]).toEqual(["0.775", "0.77828"]);
+  });
 });
 
 describe("quick test", () => {
@@ -234,6 +251,11 @@ describe("quick test", () => {
     click(testid(element, "qt-run"));
     expect(props.onRefuse).toHaveBeenLastCalledWith('Target velocity: "2,5": use "." as decimal separator');
     expect(props.onRun).not.toHaveBeenCalled();
+  });
+
+  it("has no profile velocity fields without a target velocity (a TTA-PRO: motions only)", () => {
+    const element = quickTest({ ...panel().props, target: null });
+    expect([testid(element, "qt-run"), testid(element, "qt-velocity")]).toEqual([null, null]);
   });
 
   it("shows the target the drive holds again after Stop", async () => {

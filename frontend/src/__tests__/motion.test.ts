@@ -1,7 +1,9 @@
 import { afterEach, beforeEach, describe, expect, it, vi } from "vitest";
 import { HoldToRun, KEEPALIVE_MS, type PageView } from "../client/motion";
 import { holdButton } from "../components/motion/hold-button";
-import { laterMotion, motionText } from "../components/motion/model";
+import { QuickMotion, homingChoice, laterMotion, motionText } from "../components/motion/model";
+import { motionPanel } from "../components/motion/motion-panel";
+import { Scope, state } from "../lib/dom";
 
 interface FakePage {
   shown: boolean;
@@ -122,5 +124,30 @@ describe("the motion kept when answers and events cross", () => {
     const next = { ...running, motion: "m8" };
     expect(laterMotion(read, next)).toBe(next);
     expect(laterMotion(read, null)).toBeNull();
+  });
+});
+
+describe("the homing method shown and started", () => {
+  const ttapro = [{ method: 128, description: "the current position (no search)" }, { method: 160, description: "marker pulse" }];
+
+  it("keeps the picked method the device has, else takes the device's first", () => {
+    expect(homingChoice([], "35")).toBe("35");
+    expect(homingChoice([{ method: 1 }, { method: 35 }], "35")).toBe("35");
+    expect(homingChoice(ttapro, "35")).toBe("128");
+  });
+
+  it("selects a TTA-PRO's first configuration with its description once the methods arrive", () => {
+    const scope = new Scope();
+    const model = new QuickMotion({ bus: "pb", node: 5, device: "ttapro", live: { on: () => () => undefined, send: () => true }, scope });
+    const element = motionPanel({ model, armed: state(true), heldElsewhere: state(false), busy: state(false), onArm: vi.fn(), onRelease: vi.fn() });
+    const select = element.querySelector<HTMLSelectElement>('[data-testid="homing-method"]')!;
+    expect(element.textContent).not.toMatch(/\((PV|PP|HM)\)/); // no CiA 402 modes on a TTA-PRO
+    model.methods.val = ttapro;
+    expect(select.value).toBe("128");
+    expect(element.querySelector('[data-testid="homing-description"]')!.textContent).toBe("the current position (no search)");
+    select.value = "160";
+    select.dispatchEvent(new Event("change"));
+    expect(element.querySelector('[data-testid="homing-description"]')!.textContent).toBe("marker pulse");
+    scope.dispose();
   });
 });

@@ -1,11 +1,9 @@
 import { describe, expect, it } from "vitest";
 import type { Motor } from "../client/api";
-import { driveFiles } from "../pages/backup";
 import { differs, shownRows, type Column } from "../pages/compare";
 import { matching } from "../pages/motors";
 import { axesRefusal, itemOf, newLine } from "../pages/terminal";
-import type { Dictionary } from "../lib/od";
-import { entry, variable } from "./fixtures";
+import { entry } from "./fixtures";
 
 describe("terminal lines", () => {
   const targets = [{ label: "demo/X", bus: "sim", node: 1 }, { label: "demo/Y", bus: "sim", node: 2 }];
@@ -61,18 +59,5 @@ describe("motor filter", () => {
     expect(matching(motors, "brushless").map((m) => m.reference)).toEqual(["SH3"]);
     expect(matching(motors, "CATALOG")).toHaveLength(2);
     expect(matching(motors, "")).toHaveLength(2);
-  });
-});
-
-describe("backup files", () => {
-  it("offers USER_PAR.TXT and SEQUENCE.TXT only when the device has them", () => {
-    const dictionary = (objects: Dictionary["objects"]): Dictionary => ({
-      device: "d", product_name: "D", vendor_id: 0, product_code: 0, revision: 0, groups: [], builtin: true, object_count: objects.length, objects,
-    });
-    const plain = entry(0x6081).object;
-    const user = entry(0x3000, { save_type: "USER_PAR" }).object;
-    const sequence = { index: 0x3601, name: "Sequence table", kind: "RECORD", group: "Sequences", subs: [variable()] };
-    expect(driveFiles(dictionary([plain]))).toEqual(["DRIVEPAR.TXT"]);
-    expect(driveFiles(dictionary([plain, user, sequence]))).toEqual(["DRIVEPAR.TXT", "USER_PAR.TXT", "SEQUENCE.TXT"]);
   });
 });

@@ -17,6 +17,7 @@ function object(index: number, name: string, kind: string, subs: OdVariable[], g
 
 const dictionary: Dictionary = {
   device: "test", product_name: "Test", vendor_id: 1, product_code: 2, revision: 3, groups: ["General", "Servo Loops"], builtin: true, object_count: 8,
+  names: { statusword: [0x6041, 0], modes_of_operation: [0x6060, 0] }, fieldbus: "CANopen", files: ["DRIVEPAR.TXT"], features: [], store: null,
   objects: [
     object(0x6041, "Statusword", "VAR", [variable(0, "Statusword", { bits: [{ first: 3, last: 3, name: "Fault" }] })]),
     object(0x6060, "Modes of operation", "VAR", [variable(0, "Modes of operation", { enum: { "1": "Profile position" } })]),
@@ -86,6 +87,7 @@ describe("dashboard signals", () => {
   it("takes the CiA 402 measurements the dictionary has and finds temperatures by unit", () => {
     const withSignals: Dictionary = {
       ...dictionary,
+      names: { ...dictionary.names, position_actual: [0x6064, 0], velocity_actual: [0x606c, 0], dc_bus_voltage: [0x3408, 1] },
       objects: [
         ...dictionary.objects,
         object(0x6064, "Position actual value", "VAR", [variable(0, "Position actual value", { access: "ro" })]),
@@ -98,5 +100,27 @@ describe("dashboard signals", () => {
     expect(signals.measurements.map(address)).toEqual(["0x6064", "0x606C", "0x3328"]);
     expect(signals.statusword && address(signals.statusword)).toBe("0x6041");
     expect(signals.inputs).toBeNull();
+    expect(signals.nmt).toBe(true);
+  });
+
+  it("finds a PROFIBUS drive's entries by the names the server gives, without NMT", () => {
+    const pnu = (index: number, name: string) => object(index, name, "VAR", [variable(0, name, { access: "ro" })]);
+    const ttapro: Dictionary = {
+      ...dictionary, device: "ttapro", fieldbus: "PROFIBUS-DP",
+      names: { statusword: [0x801, 0], position_actual: [774, 0], dc_bus_voltage: [706, 0], speed_monitor: [776, 0], following_error_actual: [749, 0] },
+      objects: [pnu(0x801, "Status word ZSW"), pnu(706, "DC bus voltage"), pnu(749, "Following error"), pnu(774, "Position"), pnu(776, "Speed monitor"), pnu(0x6041, "Not a status word")],
+    };
+    const signals = dashboardSignals(ttapro);
+    expect(signals.statusword?.object.index).toBe(0x801);
+    expect(signals.measurements.map((entry) => entry.object.index)).toEqual([774, 776, 749, 706]);
+    expect([signals.mode, signals.targetVelocity, signals.nmt]).toEqual([null, null, false]);
+  });
+
+  it("takes CiA 402's DC link voltage before a device's own DC bus voltage", () => {
+    const both: Dictionary = {
+      ...dictionary, names: { dc_link_voltage: [0x6079, 0], dc_bus_voltage: [0x3408, 1] },
+      objects: [object(0x3408, "DC voltage", "RECORD", [variable(1, "DC voltage", { access: "ro" })]), object(0x6079, "DC link", "VAR", [variable(0, "DC link", { access: "ro" })])],
+    };
+    expect(dashboardSignals(both).measurements.map(address)).toEqual(["0x6079"]);
   });
 });

@@ -1,6 +1,6 @@
 import { describe, expect, it } from "vitest";
 import type { OdVariable } from "../lib/od";
-import { editText, formatRange, formatValue, parseValue, sameValue } from "../lib/values";
+import { editText, formatRange, formatValue, LIVE_DIGITS, parseValue, sameValue } from "../lib/values";
 
 function variable(extra: Partial<OdVariable>): OdVariable {
   return {
@@ -18,6 +18,32 @@ describe("values", () => {
     expect(formatValue(current, -250)).toBe("-0.25");
     expect(editText(current, 1500)).toBe("1.5");
     expect(formatValue(current, null)).toBe("");
+  });
+
+  it("shows a scaled integer at its resolution, and an edit keeps every digit", () => {
+    const monitor = variable({ data_type: "INTEGER16", unit: "A", scale: 0.0061038881767686015 });
+    expect(formatValue(monitor, 127)).toBe("0.775"); // one step is 0.0061 A: three decimals tell steps apart
+    expect(formatValue(monitor, 128)).toBe("0.781");
+    expect(editText(monitor, 127)).toBe("0.7751937985");
+    expect(parseValue(monitor, editText(monitor, 127))).toEqual({ ok: true, raw: 127 });
+    const fine = variable({ data_type: "INTEGER32", scale: 1.52587890625e-5 });
+    expect(formatValue(fine, 51005)).toBe("0.77827");
+    const offset = variable({ data_type: "UNSIGNED8", scale: 1, offset: 2.5 });
+    expect(formatValue(offset, 3)).toBe("5.5");
+    expect(formatValue(variable({ data_type: "UNSIGNED32" }), 123456789)).toBe("123456789");
+  });
+
+  it("shows a REAL without the float's noise, a live readout with LIVE_DIGITS, and edits at full precision", () => {
+    const real = variable({ data_type: "REAL32", unit: "A" });
+    expect(formatValue(real, 0.7782819016)).toBe("0.7782819");
+    expect(formatValue(real, Math.fround(0.1))).toBe("0.1"); // 0.10000000149 as a REAL32 holds it
+    expect(formatValue(real, 0.7782819016, LIVE_DIGITS)).toBe("0.77828");
+    expect(editText(real, 0.7782819016)).toBe("0.7782819016");
+    expect(parseValue(real, editText(real, 0.7782819016))).toEqual({ ok: true, raw: 0.7782819016 });
+    const position = variable({ data_type: "INTEGER32", scale: 0.001 });
+    expect(formatValue(position, 123456789)).toBe("123456.789"); // a stored value keeps its resolution
+    expect(formatValue(position, 123456789, LIVE_DIGITS)).toBe("123457");
+    expect(formatValue(variable({ data_type: "INTEGER32" }), 123456789, LIVE_DIGITS)).toBe("123456789"); // counts stay whole
   });
 
   it("parses typed physical values back to raw, '.' only", () => {

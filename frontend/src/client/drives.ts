@@ -20,6 +20,7 @@ export type ReadResult = Schemas["ReadResult"];
 export type DriveStateInfo = Schemas["DriveState"];
 export type FaultInfo = Schemas["FaultInfoModel"];
 export type FaultReport = Schemas["FaultReportModel"];
+export type StoreAnswer = Schemas["StoreModel"];
 
 /** One value of a batch read, keyed like the dictionary. */
 export interface ReadValue {
@@ -137,5 +138,7 @@ export const driveApi = {
     whenMapped(() => put<DriveStateInfo>(`${nodePath(bus, node)}/state`, { target })),
   faults: (bus: string, node: number) => whenMapped(() => get<FaultReport>(`${nodePath(bus, node)}/faults`)),
   resetFaults: (bus: string, node: number) => whenMapped(() => post<FaultReport>(`${nodePath(bus, node)}/faults/reset`)),
+  /** Store the drive's parameters in its non-volatile memory (the device's own save, the dictionary's `store`). */
+  store: (bus: string, node: number) => whenMapped(() => post<StoreAnswer>(`${nodePath(bus, node)}/store`)),
   fileUrl: (bus: string, node: number, name: string) => `${nodePath(bus, node)}/files/${e(name)}`,
 };

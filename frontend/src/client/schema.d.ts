@@ -920,6 +920,23 @@ export interface paths {
         patch?: never;
         trace?: never;
     };
+    "/api/buses/{bus}/nodes/{node}/store": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        get?: never;
+        put?: never;
+        /** Store the drive's parameters in its non-volatile memory (the profile's save: 0x1010,1 = 'save', a TTA-PRO's PNU 729 = 1); refused while enabled on a drive that saves only disabled */
+        post: operations["store_parameters_api_buses__bus__nodes__node__store_post"];
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
     "/api/buses/{bus}/restore": {
         parameters: {
             query?: never;
@@ -2576,8 +2593,51 @@ export interface components {
              * @example xtrapulspac
              */
             device: string;
+            /**
+             * Features
+             * @description the services the device has, of scope, procedures, frequency_response, sequences, io: what a client offers it (the server refuses the others)
+             * @example [
+             *       "scope",
+             *       "procedures",
+             *       "frequency_response",
+             *       "sequences",
+             *       "io"
+             *     ]
+             * @example []
+             */
+            features: string[];
+            /**
+             * Fieldbus
+             * @example CANopen
+             * @example PROFIBUS-DP
+             */
+            fieldbus: string;
+            /**
+             * Files
+             * @description the drive's own files a backup of this device holds, in the order a restore writes them
+             * @example [
+             *       "DRIVEPAR.TXT",
+             *       "USER_PAR.TXT",
+             *       "SEQUENCE.TXT"
+             *     ]
+             * @example [
+             *       "TTAPAR.TXT",
+             *       "TTASEQ.TXT"
+             *     ]
+             */
+            files: string[];
             /** Groups */
             groups: string[];
+            /**
+             * Names
+             * @description the device profile's semantic names (statusword, position_actual, …) that this dictionary has → [index, sub]: how a client finds this device's entries by meaning
+             */
+            names: {
+                [key: string]: [
+                    number,
+                    number
+                ];
+            };
             /** Object Count */
             object_count: number;
             /** Objects */
@@ -2591,6 +2651,13 @@ export interface components {
             product_name: string;
             /** Revision */
             revision: number;
+            /**
+             * Store
+             * @description what storing the parameters (POST …/store) writes on this device, in its dictionary's words
+             * @example 0x1010,1 Store parameters.Save all parameters = 'save'
+             * @example PNU 729 Save parameters in EEPROM = 1
+             */
+            store: string | null;
             /** Vendor Id */
             vendor_id: number;
         };
@@ -5108,6 +5175,26 @@ export interface components {
              * @description switch-on-disabled | ready-to-switch-on | switched-on | operation-enabled | quick-stop-active
              */
             target: string;
+        };
+        /** StoreModel */
+        StoreModel: {
+            /** Node */
+            node: number;
+            /** Seconds */
+            seconds: number;
+            /**
+             * Stored
+             * @description the profile's procedure that ran
+             * @example save
+             */
+            stored: string;
+            /**
+             * Wrote
+             * @description what it wrote, in the dictionary's words
+             * @example PNU 729 Save parameters in EEPROM = 1
+             * @example 0x1010,1 Store parameters.Save all parameters = 'save'
+             */
+            wrote: string;
         };
         /**
          * StreamPlanModel
@@ -10514,6 +10601,98 @@ export interface operations {
                 };
                 content: {
                     "application/json": components["schemas"]["DriveState"];
+                };
+            };
+            /** @description `not_found`: unknown bus, node, job, object, device, project, axis or motor */
+            404: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `conflict`: the current state refuses it: a changed project, a taken name, the drive; `refused_for_safety`: refused to keep the machine safe (no live client, drive enabled) */
+            409: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `invalid_input`: refused before anything was sent or written */
+            422: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `internal`: a bug: logged with the request id */
+            500: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `communication`: the drive or the link failed part-way (incomplete backup or restore) */
+            502: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `unavailable`: the bus is not connected, or an axis's drive cannot be reached */
+            503: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+            /** @description `timeout`: the drive did not answer in time */
+            504: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ErrorBody"];
+                };
+            };
+        };
+    };
+    store_parameters_api_buses__bus__nodes__node__store_post: {
+        parameters: {
+            query?: {
+                /** @description device key (xtrapulspac, cd1k, …) overriding the identified one; by default the node is identified on first use */
+                device?: string | null;
+            };
+            header?: {
+                /** @description id announced by /api/ws/events; required for motion */
+                "X-Servo-Client"?: string | null;
+            };
+            path: {
+                node: number;
+                bus: string;
+            };
+            cookie?: never;
+        };
+        requestBody?: never;
+        responses: {
+            /** @description Successful Response */
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["StoreModel"];
                 };
             };
             /** @description `not_found`: unknown bus, node, job, object, device, project, axis or motor */

@@ -3,11 +3,21 @@
  * stores); the user reads and types physical values: physical = raw * scale + offset, in the entry's unit.
  */
 
-import { formatHex, formatNumber, fromPhysical, parseNumber, toPhysical } from "./numbers";
+import { formatHex, formatNumber, fromPhysical, parseNumber, roundNoise, toPhysical } from "./numbers";
 import { hexWidth, rawRange, valueKind, type OdVariable, type Scalar } from "./od";
 
-/** The value as a table cell shows it: enum text, hex word, pointer, physical number or text. */
-export function formatValue(variable: OdVariable, raw: Scalar | undefined): string {
+/** Significant digits of a REAL readout: a REAL32 holds about 7, the digits after them are the float's noise. */
+export const FLOAT_DIGITS = 7;
+/** Significant digits of a live readout (a measurement that changes at every sample): the last ones only flicker. */
+export const LIVE_DIGITS = 5;
+
+/**
+ * The value as a table cell or readout shows it: enum text, hex word, pointer, physical number or text. A scaled
+ * integer shows its resolution (the decimals of one step of the scale), a REAL `FLOAT_DIGITS` significant digits;
+ * `digits` (a live readout: `LIVE_DIGITS`) caps the significant digits further. Only what is shown is rounded: an
+ * edit field starts from `editText`, which keeps every digit.
+ */
+export function formatValue(variable: OdVariable, raw: Scalar | undefined, digits?: number): string {
   if (raw === null || raw === undefined) return "";
   if (typeof raw === "string") return raw;
   const kind = valueKind(variable.data_type);
@@ -17,7 +27,26 @@ export function formatValue(variable: OdVariable, raw: Scalar | undefined): stri
     if (variable.is_pointer) return formatHex(raw, 8);
     if (variable.bits.length > 0) return formatHex(raw, hexWidth(variable.data_type));
   }
-  return formatNumber(toPhysical(raw, variable.scale, variable.offset));
+  return formatReadout(variable, raw, kind === "integer", digits);
+}
+
+function formatReadout(variable: OdVariable, raw: number, integer: boolean, digits?: number): string {
+  const physical = toPhysical(raw, variable.scale, variable.offset);
+  if (!integer) return formatNumber(physical, Math.min(digits ?? FLOAT_DIGITS, FLOAT_DIGITS));
+  const stepped = Number(physical.toFixed(resolutionDecimals(variable)));
+  return formatNumber(stepped, digits ?? 15);
+}
+
+/**
+ * Decimals that tell two neighbouring raw values of an integer entry apart: those of one scale step (0.1 → 1,
+ * 0.0061 → 3) and of the offset (2.5 → 1).
+ */
+export function resolutionDecimals(variable: OdVariable): number {
+  const step = Math.abs(variable.scale || 1);
+  const ofStep = Math.max(0, Math.ceil(-Math.log10(step) - 1e-9));
+  const offset = roundNoise(variable.offset || 0);
+  const ofOffset = Number.isInteger(offset) ? 0 : (String(offset).split(".")[1]?.length ?? 0);
+  return Math.min(Math.max(ofStep, ofOffset), 12);
 }
 
 /** Plain text for an input field: the physical number, hex for words and pointers, the raw text otherwise. */

@@ -5,6 +5,7 @@ import { getDictionary, projects, type AxisConfig, type Project } from "../clien
 import { h, Scope } from "../lib/dom";
 import { forNode, type Dictionary } from "../lib/od";
 import { buildPath, type AxisView } from "../lib/router";
+import { axisTab, axisTabs } from "../lib/axis-tabs";
 import { axisStateText } from "../client/live";
 import { reportButton } from "../components/report/button";
 import { backupView } from "./backup";
@@ -32,20 +33,6 @@ export interface AxisViewPage {
   shortcut?(action: string): boolean;
 }
 
-const VIEWS: [AxisView, string, string][] = [
-  ["dashboard", "Dashboard", "g d"],
-  ["parameters", "Parameters", "g p"],
-  ["commissioning", "Commissioning", "g c"],
-  ["backup", "Backup / restore", "g k"],
-  ["scope", "Scope", "g s"],
-  ["current-loop", "Current loop", ""],
-  ["phasing", "Phasing", ""],
-  ["tuning", "Auto-tuning", ""],
-  ["bode", "Bode / what-if", ""],
-  ["sequences", "Sequences", ""],
-  ["io", "I/O", ""],
-];
-
 export async function axisPage(context: PageContext, projectName: string, axisName: string, view: AxisView): Promise<Page> {
   // The tree already knows the axis's device: fetch its dictionary while the project is fetched.
   const known = context.app.projectsLoaded().find((p) => p.name === projectName)?.axes.find((a) => a.name === axisName);
@@ -59,7 +46,9 @@ export async function axisPage(context: PageContext, projectName: string, axisNa
   const shared = await (known?.device === axis.device && early ? early : getDictionary(axis.device));
   const dictionary = forNode(shared, axis.node_id);
   const axisContext: AxisContext = { page: context, project, axis, dictionary };
-  const viewPage = await (view === "dashboard" ? dashboardView(axisContext)
+  const tabs = axisTabs(dictionary);
+  const viewPage = await (!tabs.some((tab) => tab.view === view) ? unavailableView(dictionary, view)
+    : view === "dashboard" ? dashboardView(axisContext)
     : view === "parameters" ? parametersView(axisContext)
       : view === "commissioning" ? commissioningView(axisContext)
         : view === "scope" ? import("./scope").then((module) => module.scopeView(axisContext)) // plotly only here
@@ -78,7 +67,7 @@ export async function axisPage(context: PageContext, projectName: string, axisNa
     const text = axisStateText(status.val);
     return [h("span", { class: `dot ${text.tone}` }), text.text];
   }));
-  const tabs = h("nav", { class: "tabs" }, VIEWS.map(([key, label, keys]) => h("a", {
+  const nav = h("nav", { class: "tabs" }, tabs.map(({ view: key, label, keys }) => h("a", {
     href: buildPath({ page: "axis", project: project.name, axis: axis.name, view: key }),
     class: key === view ? "active" : "", title: keys ? `${label} (${keys})` : label, "data-testid": `tab-${key}`,
   }, label)));
@@ -86,10 +75,10 @@ export async function axisPage(context: PageContext, projectName: string, axisNa
     h("h1", { "data-testid": "axis-title" }, axis.name),
     h("span", { class: "muted" }, `${dictionary.product_name} · node ${axis.node_id} · bus ${axis.bus}${axis.motor ? ` · motor ${axis.motor}` : ""}`),
     state, reportButton(project.name, axis.name));
-  const wrapper = h("div", { class: "page", style: { paddingBottom: "0", flex: "none" } }, head, tabs);
+  const wrapper = h("div", { class: "page", style: { paddingBottom: "0", flex: "none" } }, head, nav);
   viewPage.element.style.flex = "1";
   return {
-    title: `${axis.name} ${VIEWS.find(([key]) => key === view)![1]}`,
+    title: `${axis.name} ${axisTab(view).label}`,
     crumbs: [h("a", { href: "/" }, "Projects"), " / ", h("a", { href: buildPath({ page: "project", project: project.name }) }, project.name), ` / ${axis.name}`],
     element: h("div", { style: { display: "flex", flexDirection: "column", flex: "1", minHeight: "0" } }, wrapper, viewPage.element),
     update: viewPage.update,
@@ -99,5 +88,13 @@ export async function axisPage(context: PageContext, projectName: string, axisNa
       scope.dispose();
       viewPage.dispose?.();
     },
+  };
+}
+
+/** A view the device cannot use (a link or a shortcut led here): say so instead of a page the server refuses. */
+function unavailableView(dictionary: Dictionary, view: AxisView): AxisViewPage {
+  return {
+    element: h("div", { class: "page" }, h("div", { class: "message warn", "data-testid": "view-unavailable" },
+      `${axisTab(view).label}: the ${dictionary.product_name} (${dictionary.fieldbus}) does not have it. Its tabs above are what it offers.`)),
   };
 }

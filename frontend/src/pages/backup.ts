@@ -1,7 +1,7 @@
 /**
- * Backup and restore of one axis: the drive's files (DRIVEPAR.TXT, USER_PAR.TXT, SEQUENCE.TXT) to and from this
- * PC, the drive's values into the project and back, and "store to flash". Long runs show progress and can be
- * cancelled between objects.
+ * Backup and restore of one axis: the drive's files (DRIVEPAR.TXT, USER_PAR.TXT, SEQUENCE.TXT; a TTA-PRO's TTAPAR.TXT,
+ * TTASEQ.TXT) to and from this PC, the drive's values into the project and back, and "store parameters" (the
+ * device's own save). Long runs show progress and can be cancelled between objects.
  */
 
 import { errorOf, projectAddress, projects, request, setParametersSkipping, type KeptRevision, type ProjectParameter } from "../client/api";
@@ -17,8 +17,6 @@ import { formatValue, sameValue, unstorableReason } from "../lib/values";
 import type { AxisContext, AxisViewPage } from "./axis";
 
 const CHUNK = 40;
-/** 'save' as the U32 the drive expects at 0x1010,1 (CiA 301: little-endian ASCII). */
-const SAVE_SIGNATURE = 0x65766173;
 
 /** What a run reports: its summary, marked as a warning when some objects were refused or unreadable. */
 interface Outcome {
@@ -70,15 +68,14 @@ export async function backupView(context: AxisContext): Promise<AxisViewPage> {
       h("div", { class: "grid cols-2" },
         h("section", { class: "panel" }, h("h2", null, "Drive ⇄ project"),
           h("div", { class: "panel-body grid", style: { gap: "8px" } },
-            h("div", { class: "muted" }, `${saved.length} saved objects of ${dictionary.product_name} (DRIVEPAR/USER_PAR), node ${view.node} on ${view.bus}, project ${project.name}.`),
+            h("div", { class: "muted" }, `${saved.length} saved objects of ${dictionary.product_name}, node ${view.node} on ${view.bus}, project ${project.name}.`),
             h("div", { class: "toolbar" },
               button("Back up drive into project", () => run(view, "Reading the drive", saved.length, backupToProject(view, saved)), "backup-to-project", true),
               button("Restore project to drive…", () => restoreFromProject(view), "restore-from-project")),
             h("div", null, () => keptLine(view, button)),
-            h("div", { class: "toolbar" }, button("Store parameters to flash", () => run(view, "Storing to flash", 1, storeToFlash(view)), "store-flash"),
-              h("span", { class: "muted" }, "0x1010,1 = 'save': the drive keeps its values after a power cycle")))),
+            storeLine(view, dictionary, button))),
         h("section", { class: "panel" }, h("h2", null, "Drive files ⇄ this PC"),
-          h("table", { class: "data" }, h("tbody", null, driveFiles(dictionary).map((name) => h("tr", null,
+          h("table", { class: "data" }, h("tbody", null, dictionary.files.map((name) => h("tr", null,
             h("td", { class: "mono" }, name),
             h("td", null, h("span", { class: "toolbar" },
               button("Back up to PC", () => run(view, `Backing up ${name}`, 1, downloadFile(view, name)), `download-${name}`),
@@ -89,14 +86,6 @@ export async function backupView(context: AxisContext): Promise<AxisViewPage> {
 /** The entries a backup reads: saved (DRIVEPAR/USER_PAR), readable and writable. */
 function savedEntries(dictionary: Dictionary): Entry[] {
   return entries(dictionary).filter((entry) => entry.variable.save_type !== "NONE" && isReadable(entry.variable.access) && isWritable(entry.variable.access));
-}
-
-/** The drive's own files the device has. */
-export function driveFiles(dictionary: Dictionary): string[] {
-  const files = ["DRIVEPAR.TXT"];
-  if (entries(dictionary).some((entry) => entry.variable.save_type === "USER_PAR")) files.push("USER_PAR.TXT");
-  if (dictionary.objects.some((object) => /sequence/i.test(object.name) && object.index >= 0x3600 && object.index < 0x3700)) files.push("SEQUENCE.TXT");
-  return files;
 }
 
 function progressLine(current: Run | null): HTMLElement | null {
@@ -262,11 +251,18 @@ async function restoreFromProject(view: BackupView): Promise<void> {
   });
 }
 
-function storeToFlash(view: BackupView): Work {
+/** "Store parameters": the device's own save, as the dictionary names it (none: no button). */
+function storeLine(view: BackupView, dictionary: Dictionary, button: Button): HTMLElement | null {
+  if (!dictionary.store) return null;
+  return h("div", { class: "toolbar" }, button("Store parameters in the drive", () => run(view, "Storing the parameters", 1, storeParameters(view)), "store-flash"),
+    h("span", { class: "muted", "data-testid": "store-action" }, `${dictionary.store}: the drive keeps the values it holds now after a power cycle`));
+}
+
+function storeParameters(view: BackupView): Work {
   return async (_signal, step) => {
-    await driveApi.write(view.bus, view.node, 0x1010, 1, SAVE_SIGNATURE);
+    const answer = await driveApi.store(view.bus, view.node);
     step(1);
-    return { text: `Node ${view.node} stored its parameters to flash (0x1010,1 = 'save').`, warning: false };
+    return { text: `Node ${view.node} stored its parameters (${answer.wrote}).`, warning: false };
   };
 }
 

@@ -7,6 +7,7 @@ import { STEPS, stepKeys, stepStatus, type Step, type StepStatus } from "../lib/
 import { h, Scope, state, type State } from "../lib/dom";
 import { formatHex } from "../lib/numbers";
 import { buildPath, type AxisView } from "../lib/router";
+import { axisTabs } from "../lib/axis-tabs";
 import type { AxisContext, AxisViewPage } from "./axis";
 
 const TICKS_KEY = "servostudio.commissioning";
@@ -108,8 +109,9 @@ function stepItem(view: ChecklistView, step: Step, position: number, status: Ste
 function stepLink(view: ChecklistView, step: Step): Node {
   const { project, dictionary } = view.context;
   const axis = view.axis.val;
-  const page = (target: AxisView, label: string, query: Record<string, string> = {}) =>
-    h("a", { class: "button", href: buildPath({ page: "axis", project: project.name, axis: axis.name, view: target }, query) }, label);
+  const offered = new Set(axisTabs(dictionary).map((tab) => tab.view)); // no link to a tab the device has not
+  const page = (target: AxisView, label: string, query: Record<string, string> = {}) => !offered.has(target) ? null
+    : h("a", { class: "button", href: buildPath({ page: "axis", project: project.name, axis: axis.name, view: target }, query) }, label);
   const firstObject = step.objects.map((o) => dictionary.objects.find((d) => d.index === o.index)).find(Boolean);
   const parameters = firstObject ? page("parameters", "Parameters", { group: firstObject.group }) : null;
   switch (step.page) {

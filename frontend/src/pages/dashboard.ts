@@ -83,6 +83,8 @@ function control(model: DashboardModel): HTMLElement {
     statusword: model.statusword, reachable: model.reachable, busy: model.busy, nmt: model.nmt, connection: model.connection,
     armed: () => heldByMe(model.control.val),
     mode: model.signals.mode,
+    nmtCommands: model.signals.nmt,
+    modes: Boolean(model.signals.mode || display),
     activeMode: () => {
       const raw = active();
       return typeof raw === "number" ? raw : null;
@@ -97,17 +99,19 @@ function control(model: DashboardModel): HTMLElement {
   });
 }
 
-/** Profile velocity quick test, when the dictionary has a target velocity and a mode of operation. */
-function quickTestPanel(model: DashboardModel, motion: QuickMotion): HTMLElement | null {
+/**
+ * The quick test: the hold-to-run motions of every device, and profile velocity when the dictionary has a target
+ * velocity and a mode of operation (a TTA-PRO has neither: it jogs, moves and homes through its control word).
+ */
+function quickTestPanel(model: DashboardModel, motion: QuickMotion): HTMLElement {
   const { targetVelocity, acceleration, deceleration, mode } = model.signals;
-  if (!targetVelocity || !mode) return null;
   const armed = () => heldByMe(model.control.val);
   return quickTest({
     motion: {
       model: motion, armed, busy: model.busy, heldElsewhere: () => Boolean(model.control.val?.holder) && !armed(),
-      onArm: () => void model.arm(), onRelease: () => void model.release(),
+      modes: Boolean(mode), onArm: () => void model.arm(), onRelease: () => void model.release(),
     },
-    acceleration, deceleration, target: targetVelocity,
+    acceleration, deceleration, target: mode ? targetVelocity : null,
     value: (entry) => model.quickValue(entry),
     onRun: (values) => void model.runQuickTest(values),
     onStop: () => model.stopQuickTest(),

@@ -6,10 +6,11 @@ locked to the SYNC while the measurement streams its excitation (docs/frequency-
 from __future__ import annotations
 
 from collections.abc import Callable, Iterator
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 
 import pytest
 from tests.support.axis_bench import AxisBench, connect
+from tests.support.plant_truth import free
 
 from servostudio.services.audit import acting_as
 from servostudio.services.cancel import Cancellation
@@ -20,12 +21,6 @@ from servostudio.sim.network import SimulatedNetwork
 from servostudio.sim.plant import Plant
 
 SDO_TIMEOUT = 3.0
-
-
-def free(plant: Plant) -> Plant:
-    """No switches or hard stops: the base speed carries the axis several revolutions."""
-    switches = {name: None for name in ("home_switch", "negative_limit_switch", "positive_limit_switch")}
-    return replace(plant, **switches, negative_hard_stop=None, positive_hard_stop=None)
 
 
 @dataclass

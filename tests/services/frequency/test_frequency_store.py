@@ -94,3 +94,17 @@ def test_a_damaged_sidecar_lists_with_its_reason_and_a_missing_csv_is_refused(pr
         store.load(directory.parents[1], "X", name)
     with pytest.raises(store.FrequencyResultNotFound):
         store.load(directory.parents[1], "X", "nothing")
+
+
+def test_a_saved_result_is_read_with_the_markers_its_points_have_today(projects):
+    """Markers are derived data: a plant saved with an anti-resonance the old definition dug out of a rigid plant's
+    noise reads without it; a two-mass plant's resonance is found from its points alone."""
+    freq = [5.0 * 1.1**n for n in range(46)]
+    rigid = [{"freq_hz": f, "magnitude_db": -20 * math.log10(2 * math.pi * f * 3e-4), "phase_deg": -90.0,
+              "coherence": 0.99} for f in freq]  # fmt: skip
+    stale = {"resonance_hz": None, "antiresonance_hz": 335.8, "bandwidth_hz": None}
+    saved = {"kind": "frequency_response", "loop": "plant", "time": "2026-12-02T05:01:02Z", "markers": stale}
+    name = store.save(projects.store, "demo", "X", {**saved, "points": rigid})
+    project_dir = projects.store.root / "demo"
+    assert store.load(project_dir, "X", name)["markers"]["antiresonance_hz"] is None
+    assert store.list_saved(project_dir, "X")[0]["markers"]["antiresonance_hz"] is None

@@ -22,7 +22,7 @@ import time
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
-from tests.services.frequency.test_measure_plants import plant_error, step_bandwidth
+from tests.support.plant_truth import plant_error, step_bandwidth
 
 from servostudio.drive.cia402 import State
 from servostudio.drive.control import set_state

@@ -7,7 +7,7 @@ from collections.abc import Iterator
 from dataclasses import replace
 
 import pytest
-from tests.services.procedures.conftest import open_bench
+from tests.support.procedure_bench import open_bench
 
 from servostudio.drive.access import Drive
 from servostudio.errors import InvalidInput

@@ -61,6 +61,18 @@ def test_keepalives_in_time_hold_and_a_dropped_hold_never_expires():
     assert not expiries.event.wait(1.5)
 
 
+def test_close_ends_the_watchdog_thread_and_a_later_hold_starts_a_new_one():
+    expiries = Expiries()
+    watch = HoldWatch(expiries, timeout=0.1)
+    watch.hold(AXIS, "a")
+    first = watch._thread
+    watch.close()
+    assert first is not None and not first.is_alive()
+    watch.hold(AXIS, "b")  # a server that holds again after a close is still watched
+    assert expiries.event.wait(5) and expiries.seen[0][1] == "b"
+    watch.close()
+
+
 def test_limits_refuse_above_and_accept_what_a_user_raised():
     store = LimitStore()
     limits = store.of(AXIS)

@@ -9,46 +9,19 @@ object 0x3428; the tool shapes, checks and verifies it.
 from __future__ import annotations
 
 import pytest
+from tests.support.procedure_bench import commission, datasheet
 
 from servostudio.services.audit import acting_as
 from servostudio.services.procedures import ProcedureRequest
 from servostudio.services.procedures.commutation import verify_commutation
-from servostudio.sim.plant import Plant
 
 SEEDS = [101, 202, 303]
 TWO_DEGREES = 65536 * 2 / 360
 
 
-def datasheet(bench, plant: Plant) -> None:
-    """What a user types in from the motor's datasheet (motor data 0x6410), and manual brake control (no brake)."""
-    machine = bench.machine()
-    for key, value in (
-        ("0x6410,7", plant.max_speed_rpm),
-        ("0x6410,9", round(plant.stall_current * 1000)),
-        ("0x6410,10", round(plant.peak_current * 1000)),
-        ("0x6410,11", round(plant.torque_constant * 1000)),
-        ("0x6410,12", round(plant.motor_inertia * 1e6)),
-        ("0x60FE,2", 1),
-        ("0x60FE,1", 0),
-    ):
-        machine.write(key, value)
-
-
 def offset_error(found: int, true: int) -> int:
     difference = (found - true) % 65536
     return min(difference, 65536 - difference)
-
-
-def commission(bench, bandwidth: int = 75, tuning_filter: str = "standard") -> tuple[Plant, dict, dict, dict]:
-    plant = bench.plant()
-    datasheet(bench, plant)
-    inductance = round(plant.inductance * 1e4) / 10  # mH, as the datasheet gives it
-    current = bench.run("current_loop", ProcedureRequest({"inductance_mh": inductance}))
-    bench.pace(2.0)  # the commutation check's pulses end after a bus round trip
-    phasing = bench.run("auto_phasing")
-    bench.pace(5.0)
-    options = {"bandwidth": bandwidth, "filter": tuning_filter, "mode": "min-overshoot"}
-    return plant, current, phasing, bench.run("auto_tuning", ProcedureRequest(options))
 
 
 @pytest.mark.parametrize("seed", SEEDS)

@@ -8,8 +8,8 @@ from __future__ import annotations
 import hashlib
 
 import pytest
-from tests.services.report.support import Page, plotted
-from tests.services.report.support import commissioned as commission_project
+from tests.support.report_project import Page, plotted
+from tests.support.report_project import commissioned as commission_project
 
 from servostudio.services.audit import Actor, AuditLog, acting_as
 from servostudio.services.frequency import store as frequency_store

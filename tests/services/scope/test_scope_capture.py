@@ -1,12 +1,12 @@
 """Captures through the capture service (``services.scope``) from a simulated XtrapulsPac, compared with the
-simulator's own signals at the recorder's sample instants (the probe of tests/sim/recorder_peer.py)."""
+simulator's own signals at the recorder's sample instants (the probe of tests/support/recorder_peer.py)."""
 
 from __future__ import annotations
 
 import itertools
 
 import pytest
-from tests.sim.recorder_peer import (
+from tests.support.recorder_peer import (
     ARM,
     CURRENT,
     POSITION,

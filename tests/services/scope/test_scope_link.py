@@ -3,32 +3,13 @@ capture works once the link is back (the simulated drives over socketcand, whose
 
 from __future__ import annotations
 
-import time
-
 import pytest
-from tests.support.embedded_sim import SDO_TIMEOUT
+from tests.support.sim_endpoints import wait_connected
 
-from servostudio.services.bus import ConnectionManager
 from servostudio.services.scope import CaptureDefinition, UploadFailed, capture, identity_of
 from servostudio.services.scope.stream import StreamFailed
 
 FULL = CaptureDefinition(("0x6064,0", "0x606C,0", "0x6062,0", "0x60F4,0"), samples=2048)  # 32 KB
-
-
-@pytest.fixture
-def connection(socketcand):
-    manager = ConnectionManager()
-    opened = manager.open(socketcand.spec, wait=5.0)
-    opened.engine.timeout = SDO_TIMEOUT
-    yield opened
-    manager.close_all()
-
-
-def wait_connected(connection, timeout: float = 15.0) -> None:
-    deadline = time.monotonic() + timeout
-    while not connection.link.connected:
-        assert time.monotonic() < deadline, "the link did not come back"
-        time.sleep(0.05)
 
 
 def test_a_cut_during_the_upload_fails_cleanly_and_the_next_capture_works(connection, socketcand, sim_network, slow):

@@ -1,6 +1,6 @@
 """Recorder captures of two axes of one bus (docs/scope.md §8): two simulated XtrapulsPacs armed together by one
 broadcast RPDO frame, judged against the simulator's own time — the virtual instant each drive took the arm and the
-values it had after each control period (the probe of tests/sim/recorder_peer.py) — and the sequential fallback
+values it had after each control period (the probe of tests/support/recorder_peer.py) — and the sequential fallback
 whose stated alignment must bound the true offset."""
 
 from __future__ import annotations
@@ -11,10 +11,10 @@ from collections.abc import Iterator
 from dataclasses import replace
 
 import pytest
-from tests.services.scope.conftest import ScopeBench, _until_booted
-from tests.sim.recorder_peer import ARM, POSITION, REV, last_write, sample_grid
 from tests.support.embedded_sim import open_sim
 from tests.support.motion import controlling
+from tests.support.recorder_peer import ARM, POSITION, REV, last_write, sample_grid
+from tests.support.scope_bench import ScopeBench, until_booted
 
 from servostudio.drive.rpdo import last_rpdo, read_rpdo
 from servostudio.drive.tpdo import read_tpdo, tpdo_slots
@@ -37,7 +37,7 @@ def axes() -> Iterator[ScopeBench]:
     try:
         two = ScopeBench(manager.get("sim"))
         for node in (1, 2):
-            _until_booted(two.drive(node))
+            until_booted(two.drive(node))
         with controlling(manager, "sim", (1, 2)):  # the NMT start of the enabled axes needs their controller
             yield two
     finally:

@@ -7,8 +7,7 @@ from __future__ import annotations
 import threading
 
 import pytest
-from tests.services.scope.test_scope_link import connection, wait_connected  # noqa: F401 -- the socketcand fixture
-from tests.services.scope.test_scope_tpdo import SyncProbe, moving, offset_of, tpdo_configuration
+from tests.support.sync_probe import SyncProbe, moving, offset_of, tpdo_configuration
 
 from servostudio.services.cancel import Cancellation
 from servostudio.services.scope import CaptureDefinition, CaptureRefused
@@ -68,7 +67,7 @@ def test_a_roll_the_bus_cannot_carry_is_refused_before_anything_is_written(bench
     assert tpdo_configuration(drive) == before
 
 
-def test_a_cut_link_is_a_reported_gap_and_the_roll_goes_on(connection, socketcand):  # noqa: F811
+def test_a_cut_link_is_a_reported_gap_and_the_roll_goes_on(connection, socketcand):
     events: list[dict] = []
 
     def cut_once(event: dict) -> None:

@@ -7,7 +7,7 @@ from __future__ import annotations
 import threading
 import time
 
-from tests.services.scope.test_scope_tpdo import POSITION, STATUS_WORD, SyncProbe, moving, offset_of, rows_of
+from tests.support.sync_probe import POSITION, STATUS_WORD, SyncProbe, moving, offset_of, rows_of
 
 from servostudio.drive.nmt import NmtCommand, send_nmt
 from servostudio.services.scope import CaptureDefinition, capture, stream

@@ -4,10 +4,9 @@ from __future__ import annotations
 
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from tests.support.sequence_programs import CONDITIONAL_JUMP, COUNTER_LOOP, program
 
 from servostudio.services import sequences
-
-from .conftest import CONDITIONAL_JUMP, COUNTER_LOOP, program
 
 
 def graph(text: str, types_mask: int = 0b11111) -> dict:

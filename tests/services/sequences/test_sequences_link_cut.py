@@ -4,13 +4,12 @@ and the flash copy is what was stored before — the drive LOADs it again once t
 from __future__ import annotations
 
 import pytest
+from tests.support.sequence_programs import CONDITIONAL_JUMP, COUNTER_LOOP
 
 from servostudio.formats.sequence import LoadMode
 from servostudio.services import sequences
 from servostudio.services.bus import ConnectionManager
 from servostudio.services.scan import scan
-
-from .conftest import CONDITIONAL_JUMP, COUNTER_LOOP
 
 NODE = 2
 CUT_AFTER = 200  # writes queued before the cut: a few sequences' worth of the 128 × 27 of a LOAD

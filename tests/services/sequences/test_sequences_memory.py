@@ -8,12 +8,11 @@ import time
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from tests.support.sequence_programs import CONDITIONAL_JUMP, COUNTER_LOOP
 
 from servostudio.errors import ServoStudioError
 from servostudio.formats.sequence import LoadMode, SequenceFileError, format_sequence_table, parse_sequence_text
 from servostudio.services import sequences
-
-from .conftest import CONDITIONAL_JUMP, COUNTER_LOOP
 
 MANUAL_BAD = """SeqNb=1
 SeqType=pos

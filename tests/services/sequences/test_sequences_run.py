@@ -7,6 +7,7 @@ import time
 
 import pytest
 from tests.support.motion import controlling
+from tests.support.sequence_programs import CONDITIONAL_JUMP, COUNTER_LOOP
 
 from servostudio.drive.cia402 import State
 from servostudio.drive.control import read_state
@@ -14,8 +15,6 @@ from servostudio.errors import InvalidInput, RefusedForSafety
 from servostudio.formats.sequence import LoadMode
 from servostudio.services import sequences
 from servostudio.services.sequences import SequenceMonitor
-
-from .conftest import CONDITIONAL_JUMP, COUNTER_LOOP
 
 WAIT = 15.0
 

@@ -10,7 +10,7 @@ each motor turn; the axis powers up at 0.
 from __future__ import annotations
 
 import pytest
-from tests.sim.acceptance.conftest import REV, Axis
+from tests.support.canopen_axis import REV, Axis
 
 HOME_OFFSET = 12_345
 TOLERANCE = 20  # user units (1/4096 rev): the position loop's rest error

@@ -4,7 +4,7 @@ read back by SDO."""
 
 from __future__ import annotations
 
-from tests.sim.acceptance.conftest import (
+from tests.support.canopen_axis import (
     REV,
     STATUS_SET_POINT_ACK,
     STATUS_TARGET_REACHED,

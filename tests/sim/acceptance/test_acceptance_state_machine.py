@@ -7,7 +7,7 @@ Automatic transitions (12 after a ramp, 13/14 on a fault) are checked in the tra
 
 from __future__ import annotations
 
-from tests.sim.acceptance.conftest import (
+from tests.support.canopen_axis import (
     CW_CHANGE_IMMEDIATELY,
     CW_ENABLE_OPERATION,
     CW_NEW_SET_POINT,

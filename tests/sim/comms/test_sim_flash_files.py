@@ -5,11 +5,10 @@ from __future__ import annotations
 import struct
 
 import pytest
+from tests.support.sim_test_drive import frames_with_id, write
 
 from servostudio.formats.objectfile import read_object_file
 from servostudio.sim.flash import LOAD, LOAD_USER, SAVE, signature
-
-from .test_sim_nmt_pdo import frames_with_id, write
 
 
 def test_signatures_are_little_endian_ascii():

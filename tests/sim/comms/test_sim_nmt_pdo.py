@@ -6,20 +6,9 @@ import itertools
 import struct
 
 import pytest
+from tests.support.sim_test_drive import frames_with_id, write
 
 from servostudio.sim import sdo_abort
-
-
-def frames_with_id(messages, can_id):
-    return [m for m in messages if m.arbitration_id == can_id]
-
-
-def write(client, node_id, index, sub, value, size=4):
-    command = {1: 0x2F, 2: 0x2B, 4: 0x23}[size]
-    response = client.sdo(
-        node_id, bytes([command]) + struct.pack("<HB", index, sub) + value.to_bytes(size, "little", signed=value < 0)
-    )
-    assert response[0] == 0x60, response.hex()
 
 
 @pytest.fixture

@@ -8,11 +8,10 @@ import threading
 import time
 
 import pytest
+from tests.support.sim_test_drive import CountingBehaviour
 
 from servostudio.sim.frame import Frame
 from servostudio.sim.network import SimulatedNetwork
-
-from .conftest import CountingBehaviour
 
 SLOW_STEP = 0.0004
 """Host seconds one 250 µs control period takes in these tests: the simulation cannot keep up with real time."""

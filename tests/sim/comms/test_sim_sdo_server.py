@@ -185,9 +185,9 @@ def test_crc16_matches_the_canopen_library(data):
 @settings(max_examples=40, deadline=None)
 @given(st.lists(st.binary(min_size=0, max_size=8), min_size=1, max_size=12))
 def test_arbitrary_requests_get_well_formed_answers(test_dictionary, requests):
-    from servostudio.sim.network import SimulatedNetwork
+    from tests.support.sim_test_drive import RawClient, counting_factory
 
-    from .conftest import RawClient, counting_factory
+    from servostudio.sim.network import SimulatedNetwork
 
     network = SimulatedNetwork(
         "1", device="testdrive", dictionaries={"testdrive": test_dictionary}, behaviour_factory=counting_factory

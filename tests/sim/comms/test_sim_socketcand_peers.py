@@ -14,12 +14,11 @@ import time
 import canopen
 import pytest
 from canopen.sdo.exceptions import SdoAbortedError
+from tests.support.sim_test_drive import DATA, counting_factory
 
 from servostudio.sim import sdo_abort
 from servostudio.sim.network import SimulatedNetwork
 from servostudio.sim.socketcand import SocketcandServer
-
-from .conftest import DATA, counting_factory
 
 EDS = str(DATA / "testdrive.eds")
 

@@ -6,6 +6,7 @@ from __future__ import annotations
 import struct
 
 import pytest
+from tests.support.sim_test_drive import counting_factory, frames_with_id, write
 
 from servostudio.formats.sequence_model import Sequence, SequenceTable
 from servostudio.formats.sequence_reader import read_sequence_file
@@ -15,9 +16,6 @@ from servostudio.od import builtin_library
 from servostudio.sim import sdo_abort
 from servostudio.sim.flash import LOAD_SEQUENCES, MERGE_SEQUENCES, SAVE_SEQUENCES
 from servostudio.sim.network import SimulatedNetwork
-
-from .conftest import counting_factory
-from .test_sim_nmt_pdo import frames_with_id, write
 
 
 @pytest.fixture

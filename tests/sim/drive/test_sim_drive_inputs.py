@@ -7,14 +7,14 @@ from __future__ import annotations
 
 from dataclasses import replace
 
+from tests.support.drive_harness import NODE_ID, EventRecorder, Harness
+
 from servostudio.od import builtin_library
 from servostudio.sim.drive import make_behaviour
 from servostudio.sim.objects import ObjectStore
 from servostudio.sim.plant import Plant
 from servostudio.sim.sequences import SequenceMemory
 from servostudio.sim.simulator_objects import with_simulator_objects
-
-from .conftest import NODE_ID, EventRecorder, Harness
 
 REV = 4096
 WIRING = 0x5F00

@@ -4,7 +4,7 @@ same procedure again needs PKE = 0 in between; values and refusals travel as the
 
 from __future__ import annotations
 
-from tests.sim.profibus.conftest import Rig, request
+from tests.support.ttapro_rig import Rig, request
 
 from servostudio.od.pnu_model import ParameterDictionary
 
@@ -47,6 +47,20 @@ def test_saving_while_enabled_is_refused_and_unsimulated_procedures_say_so(rig: 
     rig.enable()
     assert rig.transaction(2, 729)[0::3] == (7, 17)
     assert rig.transaction(2, 736, 1)[0::3] == (7, 18)
+
+
+def test_feedback_programming_runs_with_the_drive_disabled_and_applies_the_selection(rig: Rig) -> None:
+    rig.write(893, 1)  # motor feedback: the encoder input
+    rig.enable()
+    assert rig.transaction(2, 894, 1)[0::3] == (7, 17)  # "with disabled positioner" (L3105)
+    assert rig.slave.feedback_programmings == []
+    rig.control(0x0406, cycles=20)  # OFF1: back to Ready for ENABLE, the power stage off
+    rig.cycle(cycles=2)
+    rig.cycle(request(2, 894, 1))
+    assert rig.pkw_reply == (1, 894, 0, 0)  # running: the simulator's 0.2 s, the real drive's ≈ 5 s
+    assert rig.run_procedure(894, 1, cycles=300) == 1
+    applied = rig.slave.feedback_programmings
+    assert len(applied) == 1 and applied[0][893] == 1 and set(applied[0]) == {890, 891, 892, 893, 898}
 
 
 def test_signed_values_travel_in_twos_complement(rig: Rig) -> None:

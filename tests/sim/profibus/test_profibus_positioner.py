@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import struct
 
-from tests.sim.profibus.conftest import ENABLED, Rig
+from tests.support.ttapro_rig import ENABLED, Rig
 
 from servostudio.sim.plant import Plant
 

@@ -4,7 +4,7 @@ modifications with IND."""
 
 from __future__ import annotations
 
-from tests.sim.profibus.conftest import Rig
+from tests.support.ttapro_rig import Rig
 
 VALID_POSITIONING = 0x0001
 CHECKSUM = 128

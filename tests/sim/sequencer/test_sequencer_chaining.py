@@ -5,8 +5,7 @@ numbers must come in exactly the documented order (decisions.md §3)."""
 from __future__ import annotations
 
 import pytest
-
-from .conftest import EXECUTED, REV, Bench
+from tests.support.sequencer_bench import EXECUTED, REV, Bench
 
 MOVE = f"""SeqType=POS
 PosType=REL

@@ -5,8 +5,7 @@ disable does to a running program."""
 from __future__ import annotations
 
 import pytest
-
-from .conftest import (
+from tests.support.sequencer_bench import (
     BEGIN,
     CRUISE,
     DECEL,

@@ -4,11 +4,11 @@ file does not declare, and a file the drive cannot take is error 44 (EMCY 0x6320
 
 from __future__ import annotations
 
+from tests.support.sequencer_bench import REV, Bench
+
 from servostudio.formats.sequence_model import BitPattern, Sequence
 from servostudio.formats.sequence_spec import SequenceType
 from servostudio.sim.flash import LOAD_SEQUENCES, MERGE_SEQUENCES, SAVE_SEQUENCES
-
-from .conftest import REV, Bench
 
 DONE, ERROR = 5, 4
 STORE, RESTORE = 0x1010, 0x1011

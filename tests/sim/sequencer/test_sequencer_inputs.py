@@ -5,10 +5,9 @@ from __future__ import annotations
 
 import canopen
 import pytest
+from tests.support.sequencer_bench import EXECUTED, SIM_PHYSICAL_INPUTS, Bench
 
 from servostudio.od import builtin_library
-
-from .conftest import EXECUTED, SIM_PHYSICAL_INPUTS, Bench
 
 IN1_TO_CONDITION_BIT_15 = 0x3601030F
 IN8_TO_CONDITION_BIT_7 = 0x36010307

@@ -5,10 +5,7 @@ Timing is judged on the probe's control periods; the peer loads the programs as 
 from __future__ import annotations
 
 import pytest
-
-from servostudio.sim.plant import Plant
-
-from .conftest import (
+from tests.support.sequencer_bench import (
     BEGIN,
     CAPTURED,
     CRUISE,
@@ -29,6 +26,8 @@ from .conftest import (
     first,
     phase_rows,
 )
+
+from servostudio.sim.plant import Plant
 
 PERIOD = 250e-6
 TIMING = 1.5 * PERIOD  # a duration measured between two control periods

@@ -7,6 +7,7 @@ from typing import Annotated
 
 from fastapi import APIRouter, Body, Response, status
 from fastapi.responses import JSONResponse, PlainTextResponse
+from pydantic import BaseModel, Field
 
 from servostudio.api.deps import Jobs, NodeDrive, OpenBus, Server
 from servostudio.api.errors import error_responses
@@ -15,7 +16,7 @@ from servostudio.api.routes.comm_models import BackupRequest, JobModel, RestoreR
 from servostudio.api.routes.drives import DRIVE_ERRORS
 from servostudio.api.security import Requires
 from servostudio.errors import ErrorKind
-from servostudio.services import transfers
+from servostudio.services import backup, transfers
 from servostudio.services.users import Level
 
 router = APIRouter(tags=["backup"])
@@ -123,3 +124,25 @@ def upload_file(
         started = transfers.start_upload(jobs, connection, drive, kind, data, store)
         return JSONResponse(started.as_dict(), status.HTTP_202_ACCEPTED)
     return JSONResponse({**transfers.upload(drive, kind, data, store).as_dict(), "file": name})
+
+
+class StoreModel(BaseModel):
+    node: int
+    stored: str = Field(description="the profile's procedure that ran", examples=["save"])
+    wrote: str = Field(
+        description="what it wrote, in the dictionary's words",
+        examples=["PNU 729 Save parameters in EEPROM = 1", "0x1010,1 Store parameters.Save all parameters = 'save'"],
+    )
+    seconds: float
+
+
+@router.post(
+    "/buses/{bus}/nodes/{node}/store",
+    response_model=StoreModel,
+    summary="Store the drive's parameters in its non-volatile memory (the profile's save: 0x1010,1 = 'save', a "
+    "TTA-PRO's PNU 729 = 1); refused while enabled on a drive that saves only disabled",
+    responses=error_responses(*DRIVE_ERRORS),
+    dependencies=[Requires(Level.MAINTENANCE)],
+)
+def store_parameters(drive: NodeDrive) -> dict:
+    return backup.store_parameters(drive)

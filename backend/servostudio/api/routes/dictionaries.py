@@ -86,6 +86,24 @@ class ObjectModel(BaseModel):
 class DictionaryModel(DictionarySummary):
     groups: list[str]
     objects: list[ObjectModel]
+    names: dict[str, tuple[int, int]] = Field(
+        description="the device profile's semantic names (statusword, position_actual, …) that this dictionary has "
+        "→ [index, sub]: how a client finds this device's entries by meaning"
+    )
+    fieldbus: str = Field(examples=["CANopen", "PROFIBUS-DP"])
+    files: list[str] = Field(
+        description="the drive's own files a backup of this device holds, in the order a restore writes them",
+        examples=[["DRIVEPAR.TXT", "USER_PAR.TXT", "SEQUENCE.TXT"], ["TTAPAR.TXT", "TTASEQ.TXT"]],
+    )
+    features: list[str] = Field(
+        description="the services the device has, of scope, procedures, frequency_response, sequences, io: what a "
+        "client offers it (the server refuses the others)",
+        examples=[["scope", "procedures", "frequency_response", "sequences", "io"], []],
+    )
+    store: str | None = Field(
+        description="what storing the parameters (POST …/store) writes on this device, in its dictionary's words",
+        examples=["0x1010,1 Store parameters.Save all parameters = 'save'", "PNU 729 Save parameters in EEPROM = 1"],
+    )
 
 
 def _summary(library: EdsLibrary, od: ObjectDictionary) -> dict:
@@ -161,7 +179,16 @@ def get_dictionary(device: str, library: Library) -> DictionaryModel:
         for obj in od.objects()
     ]
     groups = list(dict.fromkeys(obj.group for obj in od.objects() if obj.group))
-    return DictionaryModel(**_summary(library, od), groups=groups, objects=objects)
+    return DictionaryModel(
+        **_summary(library, od),
+        groups=groups,
+        objects=objects,
+        names=dictionaries.profile_names(od),
+        fieldbus=dictionaries.fieldbus(od),
+        files=dictionaries.drive_files(od),
+        features=dictionaries.features(od),
+        store=dictionaries.store_action(od),
+    )
 
 
 @router.post(

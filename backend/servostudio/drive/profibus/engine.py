@@ -10,7 +10,8 @@ unchanged.
 - Width and sign come from the node's parameter list (every PNU is a word or a double word, so there is no
   segmented or block transfer); a write of a procedure PNU (729 save, …) waits until the drive reports it done.
 - Each node has one worker thread and two lanes, as the SDO engine: single requests someone waits for first, the
-  batches of a backup or restore behind them.
+  batches of a backup or restore behind them. The lanes, the futures and the batches (``on_each``, ``cancel()``,
+  the bounded wait) are the SDO engine's own, from ``drive/transfers.py``; only the carrying out is this engine's.
 - Outcomes are the SDO engine's error classes, so the services that tell a refusal from a lost link keep doing so:
   a negative PKW reply is `PkwRefusal` (an `SdoAbortError`, 409 / exit 3) with the manual's text naming the PNU;
   no reply in time `PkwNoReply` (`SdoTimeoutError`), a station or line lost `PkwLinkLost` (`SdoLinkError`).
@@ -27,11 +28,10 @@ from __future__ import annotations
 import functools
 import threading
 import time
-from collections import deque
 from collections.abc import Callable, Sequence
 from concurrent.futures import CancelledError, Future
 from dataclasses import dataclass
-from typing import Any, Protocol, TypeVar
+from typing import Any, TypeVar
 
 from servostudio.drive.link import BusLink
 from servostudio.drive.profibus.client import PKW_TIMEOUT, PROCEDURE_TIMEOUT, ProfibusLinkDown, TtaProClient
@@ -40,7 +40,8 @@ from servostudio.drive.profibus.pkw import read_request, write_request
 from servostudio.drive.profibus.pkw_errors import PkwError, PkwRefused
 from servostudio.drive.profibus.pkw_handshake import reply_value
 from servostudio.drive.profibus.pzd import join_double, split_double
-from servostudio.drive.sdo import SdoAbortError, SdoEngine, SdoError, SdoLinkError, SdoTimeoutError, TransferBatch
+from servostudio.drive.sdo import SdoAbortError, SdoEngine, SdoError, SdoLinkError, SdoTimeoutError
+from servostudio.drive.transfers import Completion, FutureCompletion, NodeLanes, TransferBatch
 from servostudio.errors import InvalidInput, ServoStudioError, Timeout
 from servostudio.od.datatypes import DataType
 from servostudio.od.pnu_model import CONTROL_WORD, POSITION_SET_POINT, STATUS_WORD, Parameter, ParameterDictionary
@@ -83,41 +84,6 @@ class PkwLinkLost(SdoLinkError):
 
 class StationOutOfRange(InvalidInput):
     """A node number no DP slave can have (126 is an unset slave's, 127 the broadcast)."""
-
-
-class Completion(Protocol):
-    """What a transfer reports to: a single future (`_Single`) or a slot of a `TransferBatch`."""
-
-    def start(self, slot: int) -> bool: ...
-    def drive_silent(self) -> None: ...
-    def done(self, slot: int, outcome: Any) -> None: ...
-
-
-class _Single:
-    """One transfer's future, its result passed through ``convert``."""
-
-    def __init__(self, convert: Callable[[Any], object] | None) -> None:
-        self.future: Future[object] = Future()
-        self.convert = convert
-
-    def start(self, slot: int) -> bool:
-        return self.future.set_running_or_notify_cancel()
-
-    def drive_silent(self) -> None:
-        """Nothing queued belongs to this transfer alone."""
-
-    def done(self, slot: int, outcome: Any) -> None:
-        if self.future.done():  # cancelled before it was carried out
-            return
-        if not isinstance(outcome, Exception) and self.convert is not None:
-            try:
-                outcome = self.convert(outcome)
-            except Exception as error:  # noqa: BLE001 -- the caller gets any error of convert, as from the SDO engine
-                outcome = error
-        if isinstance(outcome, Exception):
-            self.future.set_exception(outcome)
-        else:
-            self.future.set_result(outcome)
 
 
 @dataclass(frozen=True)
@@ -169,7 +135,7 @@ class PkwEngine(SdoEngine):
         convert: Callable[[bytes], object] | None = None,
         bulk: bool = False,
     ) -> Future:
-        completion = _Single(convert)
+        completion = FutureCompletion(convert)
         self._submit_pkw([_Transfer(node, index, sub, None, timeout or self.timeout, completion)], bulk)
         return completion.future
 
@@ -181,9 +147,8 @@ class PkwEngine(SdoEngine):
         convert: Callable[[int, bytes], R] | None = None,
         on_each: Callable[[int, R | Exception], None] | None = None,
     ) -> TransferBatch[R]:
-        batch: TransferBatch[R] = TransferBatch(len(objects), convert, on_each)
         seconds = timeout or self.timeout
-        batch.patience += len(objects) * seconds
+        batch: TransferBatch[R] = TransferBatch(len(objects), convert, on_each, each=seconds)
         transfers = [_Transfer(node, pnu, ind, None, seconds, batch, slot) for slot, (pnu, ind) in enumerate(objects)]
         self._submit_pkw(transfers, bulk=True)
         return batch
@@ -198,7 +163,7 @@ class PkwEngine(SdoEngine):
         convert: Callable[[None], object] | None = None,
         bulk: bool = False,
     ) -> Future:
-        completion = _Single(convert)
+        completion = FutureCompletion(convert)
         self._submit_pkw([_Transfer(node, index, sub, bytes(data), timeout or self.timeout, completion)], bulk)
         return completion.future
 
@@ -210,9 +175,8 @@ class PkwEngine(SdoEngine):
         convert: Callable[[int, None], R] | None = None,
         on_each: Callable[[int, R | Exception], None] | None = None,
     ) -> TransferBatch[R]:
-        batch: TransferBatch[R] = TransferBatch(len(writes), convert, on_each)
         seconds = timeout or self.timeout
-        batch.patience += len(writes) * max(seconds, PROCEDURE_TIMEOUT)
+        batch: TransferBatch[R] = TransferBatch(len(writes), convert, on_each, each=max(seconds, PROCEDURE_TIMEOUT))
         transfers = [
             _Transfer(node, pnu, ind, bytes(data), seconds, batch, slot) for slot, (pnu, ind, data) in enumerate(writes)
         ]
@@ -391,7 +355,7 @@ class _NodeWorker:
 
     def __init__(self, node: int, run: Callable[[_Transfer], None]) -> None:
         self._run = run
-        self._lanes: tuple[deque[_Transfer], deque[_Transfer]] = (deque(), deque())
+        self._lanes: NodeLanes[_Transfer] = NodeLanes()
         self._condition = threading.Condition()
         self._stopped = False
         self._thread = threading.Thread(target=self._loop, name=f"pkw-node-{node}", daemon=True)
@@ -401,7 +365,7 @@ class _NodeWorker:
         with self._condition:
             stopped = self._stopped or link.closed
             if not stopped:
-                self._lanes[1 if bulk else 0].extend(transfers)
+                self._lanes.add(transfers, bulk)
                 self._condition.notify()
         if stopped:
             _closed(transfers)
@@ -410,9 +374,7 @@ class _NodeWorker:
         """End the thread; the transfers still queued end with `PkwLinkLost` (the bus was closed)."""
         with self._condition:
             self._stopped = True
-            left = [*self._lanes[0], *self._lanes[1]]
-            self._lanes[0].clear()
-            self._lanes[1].clear()
+            left = self._lanes.drain()
             self._condition.notify()
         _closed(left)
         if self._thread is not threading.current_thread():
@@ -424,11 +386,8 @@ class _NodeWorker:
 
     def _next(self) -> _Transfer | None:
         with self._condition:
-            self._condition.wait_for(lambda: self._stopped or any(self._lanes))
-            if self._stopped:
-                return None
-            lane = self._lanes[0] or self._lanes[1]
-            return lane.popleft()
+            self._condition.wait_for(lambda: self._stopped or bool(self._lanes))
+            return None if self._stopped else self._lanes.next()
 
 
 def _closed(transfers: list[_Transfer]) -> None:

@@ -9,6 +9,7 @@ from typing import TYPE_CHECKING
 
 from servostudio.drive.faults import CodedBits, FaultInfo, cia402_error_text
 from servostudio.drive.profiles.procedures import NO_PROCEDURES, ProcedureSet
+from servostudio.drive.profiles.sequence_buffer import SequenceBuffer
 from servostudio.drive.profiles.speed_loop import SpeedLoopDescription
 from servostudio.errors import NotFound
 from servostudio.od.model import SaveType
@@ -40,6 +41,8 @@ CIA402_OBJECTS: dict[str, tuple[int, int]] = {
     "modes_of_operation_display": (0x6061, 0),
     "position_actual": (0x6064, 0),
     "velocity_actual": (0x606C, 0),
+    "following_error_actual": (0x60F4, 0),
+    "dc_link_voltage": (0x6079, 0),
     "target_position": (0x607A, 0),
     "target_velocity": (0x60FF, 0),
     "target_torque": (0x6071, 0),
@@ -70,6 +73,8 @@ CIA402_TORQUE_OBJECTS: dict[str, tuple[int, int]] = {
     "torque_actual": (0x6077, 0),
     "current_actual": (0x6078, 0),
 }
+#: The CiA 402 digital inputs and outputs (the families with an I/O description name them in their own profiles)
+CIA402_IO_OBJECTS: dict[str, tuple[int, int]] = {"digital_inputs": (0x60FD, 0), "digital_outputs": (0x60FE, 1)}
 #: The CiA 402 objects that set an axis moving or change how it moves: the control word, the mode, the targets
 #: and offsets, the motion profile.  Only the axis's controller may write them (``services.motion``).
 CIA402_MOTION_OBJECTS: frozenset[str] = frozenset(
@@ -137,6 +142,18 @@ class ManualMotions:
     homing_configuration: str = "homing_configuration"
 
 
+@dataclass(frozen=True)
+class ProcedureAfterChange:
+    """A procedure the drive needs after some of its parameters changed, before they take effect (the TTA-PRO's motor
+    feedback programming, PNU 894, after its feedback selection 890-893/898): a restore that changes one of
+    ``objects`` (semantic names) runs ``procedure`` (a name ``DeviceProfile.signature`` knows) right after them."""
+
+    procedure: str
+    objects: tuple[str, ...]
+    #: seconds the procedure may take on the real drive, with margin
+    timeout: float
+
+
 class ProfileError(NotFound, KeyError):
     """The device has no object or signature of that semantic name."""
 
@@ -184,10 +201,14 @@ class DeviceProfile:
     parameter_files: Mapping[str, SaveType] = field(default_factory=lambda: {"DRIVEPAR.TXT": SaveType.DRIVEPAR})
     #: the sequence file is read through the sequence objects (XtrapulsPac)
     has_sequences: bool = False
+    #: a sequence table kept in EEPROM behind a buffer, backed up in a file of its own (the TTA-PRO's)
+    sequence_buffer: SequenceBuffer | None = None
     #: objects (semantic names) a restore writes before the rest of a file, in this order: those the others are
     #: scaled by or depend on (the TTA-PRO's maximum speed, position resolution and feedback selection); the rest
     #: follow in the file's order
     restore_first: tuple[str, ...] = ()
+    #: procedures a restore runs after writing objects whose value it changed (the TTA-PRO's feedback programming)
+    procedures_after_change: tuple[ProcedureAfterChange, ...] = ()
     addressing: Addressing = Addressing()
     #: objects (semantic names) that set the axis moving or change how it moves: the controller's alone
     motion_objects: frozenset[str] = CIA402_MOTION_OBJECTS
@@ -265,6 +286,6 @@ def generic_profile(device: str) -> DeviceProfile:
     """Plain CiA 301 + 402: standard objects and the standard 'save' signature."""
     return DeviceProfile(
         device=device,
-        objects={**CIA301_OBJECTS, **CIA402_OBJECTS, **CIA402_TORQUE_OBJECTS},
+        objects={**CIA301_OBJECTS, **CIA402_OBJECTS, **CIA402_TORQUE_OBJECTS, **CIA402_IO_OBJECTS},
         signatures={"save": ("store_parameters", "save"), "load": ("restore_parameters", "load")},
     )

@@ -14,7 +14,8 @@ engine carries them through PZD. Their bits 0-3 and 7 (status bits 0-6) are CiA 
 from __future__ import annotations
 
 from servostudio.drive.profibus.pzd import ControlBit, StatusBit
-from servostudio.drive.profiles.base import Addressing, DeviceProfile, ManualMotions
+from servostudio.drive.profiles.base import Addressing, DeviceProfile, ManualMotions, ProcedureAfterChange
+from servostudio.drive.profiles.sequence_buffer import SequenceBuffer
 from servostudio.drive.profiles.ttapro_faults import (
     ERRORS,
     POSITIONER_ERRORS_FIRST,
@@ -97,6 +98,7 @@ _OBJECTS: dict[str, tuple[int, int]] = {
     "encoder_interpolation": (892, 0),
     "motor_feedback_selection": (893, 0),
     "sincos_feedback_tracks": (898, 0),
+    "motor_feedback_programming": (894, 0),
     # monitors, versions, faults
     "drive_error_code": (755, 0),
     "digital_inputs": (769, 0),
@@ -108,6 +110,22 @@ _OBJECTS: dict[str, tuple[int, int]] = {
     "current_monitor": (777, 0),
     "power_stage_fault_code": (778, 0),
     "warning_code": (873, 0),
+    # the sequence table: procedures between the EEPROM and the buffer, and the buffer's fields
+    "sequence_read": (780, 0),
+    "sequence_write": (781, 0),
+    "sequence_control": (782, 0),
+    "sequence_position": (783, 0),
+    "sequence_speed": (784, 0),
+    "sequence_acceleration": (785, 0),
+    "sequence_deceleration": (786, 0),
+    "sequence_time": (787, 0),
+    "sequence_link": (788, 0),
+    "sequence_counter": (789, 0),
+    "sequence_counter_link": (790, 0),
+    "sequence_condition": (791, 0),
+    "sequence_outputs": (792, 0),
+    "sequence_trigger_position": (793, 0),
+    "sequence_torque_or_ratio": (794, 0),
     # process data (PZD1), not PNUs
     "controlword": (CONTROL_WORD, 0),
     "statusword": (STATUS_WORD, 0),
@@ -126,6 +144,45 @@ RESTORE_FIRST = (
 )
 """What a TTAPAR.TXT restore writes first: speeds are stored as % of 721, positions count in 740/870's units."""
 
+FEEDBACK_PROGRAMMING = ProcedureAfterChange(
+    "program_feedback",
+    (
+        "encoder_input_selection",
+        "encoder_input_resolution",
+        "encoder_interpolation",
+        "motor_feedback_selection",
+        "sincos_feedback_tracks",
+    ),
+    timeout=15.0,
+)
+"""PNU 894 after a restore changed 890-893/898: the selection is "only valid after the end of the Motor Feedback
+Programmation procedure" (L3027-3110), which takes about 5 s on the drive (with the drive disabled)."""
+
+SEQUENCE_FILE = "TTASEQ.TXT"
+"""The backup of the 128 sequences (saved by PNU 781 per sequence, then 781 = 128), docs/profibus.md §13."""
+SEQUENCE_BUFFER = SequenceBuffer(
+    file=SEQUENCE_FILE,
+    count=128,
+    read="sequence_read",
+    write="sequence_write",
+    checksum_value=128,
+    fields=(
+        "sequence_control",
+        "sequence_position",
+        "sequence_speed",
+        "sequence_acceleration",
+        "sequence_deceleration",
+        "sequence_time",
+        "sequence_link",
+        "sequence_counter",
+        "sequence_counter_link",
+        "sequence_condition",
+        "sequence_outputs",
+        "sequence_trigger_position",
+        "sequence_torque_or_ratio",
+    ),
+)
+
 #: the quick test's moves and homing: CW12 / CW13 toggled (to the PZD5-6 set point at PNU 760 rpm), CW11 rising
 #: (PNU 766's configuration); ZSW12 toggles when the drive takes one, ZSW10 position reached, ZSW11 home found
 MANUAL_MOTIONS = ManualMotions(
@@ -142,11 +199,14 @@ TTAPRO = DeviceProfile(
     device="ttapro",
     objects=_OBJECTS,
     #: PNU 729 is a procedure: writing it saves every E parameter (the drive refuses it while enabled, error 17)
-    procedure_values={"save": ("save_parameters", 1)},
+    procedure_values={"save": ("save_parameters", 1), "program_feedback": ("motor_feedback_programming", 1)},
     parameter_files={PARAMETER_FILE: SaveType.DRIVEPAR},
     #: the manual's restore order (L467-480 of the extraction, §5.2): 721 and 740/870 before what is scaled by them,
-    #: the feedback selection 890-893/898 before the rest; the save (729) at the end, with the drive disabled
+    #: the feedback selection 890-893/898 before the rest, then its programming (894) when the restore changed it;
+    #: the save (729) at the end, with the drive disabled
     restore_first=RESTORE_FIRST,
+    procedures_after_change=(FEEDBACK_PROGRAMMING,),
+    sequence_buffer=SEQUENCE_BUFFER,
     save_needs_disabled=True,
     addressing=Addressing(node_ids=range(1, 126), reason="PROFIBUS-DP station addresses are 1-125"),
     #: what moves the axis or changes how it moves: the PZD control word (the guard judges it through the CiA 402

@@ -62,6 +62,7 @@ XTRAPULSPAC = DeviceProfile(
         "max_current": (0x6073, 0),
         "rated_current": (0x6075, 0),
         "current_actual": (0x6078, 0),
+        "torque_actual": (0x6077, 0),
         "current_monitor_filter": (0x3078, 0),  # the frequency response opens it while it records 0x6078
         "pole_pairs": (0x3410, 1),
         # procedures (services.procedures; drive/profiles/xtrapulspac_procedures.py)

@@ -5,6 +5,10 @@ The CSV holds the points in exactly the pinned columns ``freq_hz,magnitude_db,ph
 without its points. Both are written atomically under the project's lock, the CSV first and the sidecar last: a
 result exists once its sidecar does. ``list_saved`` and ``load`` read a project directory directly, so the report
 works offline from the files alone. Saved results are records, not part of the project's revision.
+
+The markers are derived from the points, so a saved result is read with the markers its points have today
+(``markers.markers_of``): one measured before a definition changed shows the current one (the anti-resonance once
+marked on rigid plants, docs/frequency-response.md §6), never a marker the code no longer makes.
 """
 
 from __future__ import annotations
@@ -18,6 +22,7 @@ from pathlib import Path
 from typing import Any
 
 from servostudio.errors import Conflict, InvalidInput, NotFound
+from servostudio.services.frequency import markers
 from servostudio.services.projects import layout
 from servostudio.services.projects.fsutil import atomic_write
 from servostudio.services.projects.names import check_name, name_taken, timestamp_name
@@ -94,7 +99,14 @@ def load(project_dir: Path, axis: str, name: str) -> dict[str, Any]:
     if not csv_path.is_file():
         raise FrequencyFileError(f"{_label(axis, csv_path)}: the file is missing")
     points = parse_points(csv_path.read_text(encoding="utf-8"), _label(axis, csv_path))
-    return {**{key: value for key, value in sidecar.items() if key != "data"}, "name": name, "points": points}
+    stored = {key: value for key, value in sidecar.items() if key != "data"}
+    return {**stored, "name": name, "points": points, "markers": _current_markers(sidecar, points)}
+
+
+def _current_markers(sidecar: Mapping[str, Any], points: list[dict[str, float]]) -> Any:
+    """The markers of the points by today's definitions; a result of an unknown loop keeps what it was saved with."""
+    loop = sidecar.get("loop")
+    return markers.markers_of(loop, points) if loop in ("plant", "closed") else sidecar.get("markers")
 
 
 def _comments(result: Mapping[str, Any]) -> list[tuple[str, str]]:
@@ -147,10 +159,10 @@ def _sidecar(path: Path, axis: str) -> dict[str, Any]:
 
 def _summary(path: Path, axis: str) -> dict[str, Any]:
     try:
-        sidecar = _sidecar(path, axis)
-    except FrequencyFileError as error:
+        loaded = load(path.parents[2], axis, path.stem)
+    except InvalidInput as error:  # a damaged file, or a name the store never gives
         return {"name": path.stem, "error": str(error)}
-    return {"name": path.stem, **{key: sidecar.get(key) for key in SUMMARY_KEYS}}
+    return {"name": path.stem, **{key: loaded.get(key) for key in SUMMARY_KEYS}}
 
 
 def _label(axis: str, path: Path) -> str:

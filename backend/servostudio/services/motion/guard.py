@@ -79,6 +79,10 @@ class MotionGuard:
         #: the quick test's jogs, moves and homing, each started through this guard (``jog``)
         self.motions = Motions(self)
 
+    def close(self) -> None:
+        """The server shuts down (after its buses closed): end the threads the guard started for it."""
+        self.motions.close()
+
     def gate(self, bus: str) -> BusGate:
         return BusGate(self, bus)
 

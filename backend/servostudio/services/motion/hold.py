@@ -39,7 +39,8 @@ class Hold:
 
 
 class HoldWatch:
-    """The held axes and their watchdog thread (started with the first hold, a daemon: it holds nothing at exit)."""
+    """The held axes and their watchdog thread (started with the first hold, a daemon: it holds nothing at exit;
+    ``close`` ends it when its server shuts down, so every app a process builds and closes leaves no thread)."""
 
     def __init__(self, expired: Expired, timeout: float = HOLD_TIMEOUT) -> None:
         self.expired = expired
@@ -77,15 +78,25 @@ class HoldWatch:
             held = self._holds.get(axis)
             return held.last if held else None
 
+    def close(self, wait: float = 1.0) -> None:
+        """End the watchdog thread (waiting up to ``wait`` seconds for it).  Called after the server closed its
+        buses, so a hold that expires while they close is still stopped.  A later ``hold`` starts a new one."""
+        with self._changed:
+            thread, self._thread = self._thread, None
+            self._changed.notify_all()
+        if thread is not None and thread is not threading.current_thread():
+            thread.join(wait)
+
     def _watch(self) -> None:
-        while True:
-            for axis, held in self._due():
+        while (due := self._due()) is not None:
+            for axis, held in due:
                 self.expired(axis, held.client, held.last)
 
-    def _due(self) -> list[tuple[Axis, Hold]]:
-        """Wait until a hold's deadline passed; return (and forget) every hold that expired."""
+    def _due(self) -> list[tuple[Axis, Hold]] | None:
+        """Wait until a hold's deadline passed; return (and forget) every hold that expired, or None once this
+        thread is no longer the watchdog (``close``)."""
         with self._changed:
-            while True:
+            while self._thread is threading.current_thread():
                 now = time.monotonic()
                 due = [(axis, held) for axis, held in self._holds.items() if now - held.last >= self.timeout]
                 if due:
@@ -94,3 +105,4 @@ class HoldWatch:
                     return due
                 deadlines = [held.last + self.timeout for held in self._holds.values()]
                 self._changed.wait(max(min(deadlines) - now, MIN_WAIT) if deadlines else None)
+            return None

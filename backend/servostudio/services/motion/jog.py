@@ -5,8 +5,9 @@ One implementation for the browser, the REST API and the CLI.  A motion is start
 only (``MotionGuard.require_controller`` before anything is written, and the guard judges every write again), within
 the axis's limits (``limits``, checked before anything is written), and ends ``done`` (jog time over, target reached,
 homed), ``stopped`` (a quick stop: the stop route, the hold-to-run watchdog, the axis leaving Operation enabled) or
-``failed``.  With ``hold`` the motion runs only while its client's keepalive arrives (``hold``).  Each change of a
-motion is published as a ``motion`` event.
+``failed`` (the drive faulted — the reason names its faults as its manual does, from the fault report through the
+device profile — or did not follow the handshake).  With ``hold`` the motion runs only while its client's keepalive
+arrives (``hold``).  Each change of a motion is published as a ``motion`` event.
 """
 
 from __future__ import annotations
@@ -21,7 +22,7 @@ from typing import TYPE_CHECKING
 
 from servostudio.drive.access import Drive
 from servostudio.drive.cia402 import State
-from servostudio.drive.control import read_state, set_state
+from servostudio.drive.control import fault_report, read_state, set_state
 from servostudio.drive.profiles.base import ManualMotions
 from servostudio.errors import Conflict, InvalidInput, ServoStudioError
 from servostudio.services.audit import Actor
@@ -38,6 +39,8 @@ PROFILE_POSITION, PROFILE_VELOCITY, HOMING = 1, 3, 6
 ENABLED = 0x000F  # control word: Enable operation
 NEW_SET_POINT, RELATIVE = 0x0010, 0x0040  # PP: bit 4 (also HM: start homing), bit 6
 TARGET_REACHED, ACKNOWLEDGED, HOMING_ERROR = 1 << 10, 1 << 12, 1 << 13  # status word bits (HM: bit 12 = attained)
+#: states of a drive that faulted: a motion that ends in one of them failed, and the fault names why
+FAULTED = (State.FAULT_REACTION_ACTIVE, State.FAULT)
 #: seconds between two status reads of a running motion
 POLL_PERIOD = 0.02
 #: seconds the drive has to acknowledge a new set-point (PP) before the move counts as failed
@@ -104,6 +107,10 @@ class Motions:
         self.holds = HoldWatch(self._expired)
         self._lock = threading.Lock()
         self._runs: dict[Axis, Run] = {}
+
+    def close(self) -> None:
+        """The server shuts down: end the hold-to-run watchdog's thread (``HoldWatch.close``)."""
+        self.holds.close()
 
     # ---- the three motions ------------------------------------------------------------------------------------
 
@@ -257,7 +264,7 @@ class Motions:
         if run.state != "running":
             return
         if state is not State.OPERATION_ENABLED:
-            self._finish(run, "stopped", f"the axis left Operation enabled ({state.value if state else '?'})")
+            self._finish(run, *_left_operation_enabled(run.drive, state))
             return
         outcome = finished(statusword)
         if outcome is not None:
@@ -308,6 +315,25 @@ class Motions:
             self.guard.quick_stop(run.axis, run.drive, why, running)
         except ServoStudioError as error:
             run.reason = f"{why}; the quick stop failed: {error}"
+
+
+def _left_operation_enabled(drive: Drive, state: State | None) -> tuple[str, str]:
+    """How a motion ends when its axis is no longer enabled: ``failed`` with the drive's faults when it faulted (a
+    following error, the TTA-PRO's homing time-out), else ``stopped`` (a stop, a lost controller)."""
+    if state in FAULTED:
+        return "failed", f"the drive faulted: {_faults_named(drive)}"
+    return "stopped", f"the axis left Operation enabled ({state.value if state else '?'})"
+
+
+def _faults_named(drive: Drive) -> str:
+    """The active faults in the manual's words (``drive.control.fault_report``: the device profile decodes the
+    drive's error words or error code), else the CiA 402 error text, else the status word."""
+    try:
+        report = fault_report(drive)
+    except ServoStudioError as error:
+        return f"its fault report could not be read ({error})"
+    names = "; ".join(fault.name for fault in report.faults)
+    return names or report.error_text or f"status word 0x{report.statusword:04X}"
 
 
 def _jog_writes(drive: Drive, velocity: float) -> tuple[list[tuple[str, int]], Callable[[Drive], None] | None]:

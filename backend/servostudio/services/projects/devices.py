@@ -20,6 +20,8 @@ def parameter_files(device: str) -> Mapping[str, SaveType]:
 
 
 def axis_files(device: str) -> tuple[str, ...]:
-    """Every file an axis directory of this device holds: the parameter files, plus SEQUENCE.TXT if it has one."""
+    """Every file an axis directory of this device holds: the parameter files, plus its sequence file if it has one
+    (SEQUENCE.TXT, or the file of a sequence table behind a buffer: the TTA-PRO's TTASEQ.TXT)."""
     profile = profile_for(device)
-    return (*profile.parameter_files, *((layout.SEQUENCE,) if profile.has_sequences else ()))
+    buffered = (profile.sequence_buffer.file,) if profile.sequence_buffer is not None else ()
+    return (*profile.parameter_files, *((layout.SEQUENCE,) if profile.has_sequences else ()), *buffered)

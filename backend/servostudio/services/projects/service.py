@@ -5,9 +5,11 @@ from __future__ import annotations
 from dataclasses import dataclass, replace
 from pathlib import Path
 
+from servostudio.drive.profiles import profile_for
 from servostudio.formats.sequence import SequenceFileError, parse_sequence_text
 from servostudio.formats.textfile import FILE_ENCODING
 from servostudio.od import ObjectDictionary, Variable, parse_dictionary
+from servostudio.services import sequence_buffer
 from servostudio.services.audit import AuditLog, ProjectAudit
 from servostudio.services.projects import layout
 from servostudio.services.projects.archive import DEFAULT_LIMITS, ArchiveLimits, archive_project, unarchive_project
@@ -146,11 +148,12 @@ class ProjectService:
         return unarchive_project(self.store, source, new_name, limits, verify=self.check_axis_files)
 
     def check_axis_files(self, directory: Path, project: Project) -> None:
-        """Check every axis's object files by the editor's rules (ranges included) and its SEQUENCE.TXT; raise
+        """Check every axis's object files by the editor's rules (ranges included) and its sequence file; raise
         :class:`FileFormatError` naming the first bad file and line."""
         for axis in project.axes:
             axis_directory = directory / axis.name
             AxisValues.load(axis_directory, self.parameters.dictionary(axis), axis.node_id, strict=True)
+            _check_sequence_buffer_file(axis_directory, axis.device, self.parameters.dictionary(axis))
             sequence = axis_directory / layout.SEQUENCE
             if sequence.is_file():
                 try:
@@ -158,6 +161,18 @@ class ProjectService:
                 except SequenceFileError as error:
                     first = error.issues[0]
                     raise FileFormatError(sequence, first.line, str(first).partition(": ")[2]) from None
+
+
+def _check_sequence_buffer_file(directory: Path, device: str, dictionary: ObjectDictionary) -> None:
+    """A TTA-PRO's TTASEQ.TXT, checked as a restore checks it (before anything is written)."""
+    profile = profile_for(device)
+    path = directory / profile.sequence_buffer.file if profile.sequence_buffer is not None else None
+    if path is None or not path.is_file():
+        return
+    try:
+        sequence_buffer.parse_table(profile, dictionary, path.read_text(encoding=FILE_ENCODING), str(path))
+    except sequence_buffer.SequenceTableInvalid as error:
+        raise FileFormatError(path, error.line, error.reason) from None
 
 
 def _configure(configuration: ObjectDictionary, values: AxisValues) -> tuple[ConfiguredValues, list[ValueChange]]:

@@ -2,9 +2,10 @@
 (TTA-PRO Profibus Communication Profile, Chapter 1 §3.2, L346-357).
 
 The simulator carries out the ones it can model faithfully: 729 (save the E parameters), 780 / 781 (sequence
-EEPROM read / write and checksum). The others (auto-phasing, auto-tuning, feedback and encoder programming,
-absolute-encoder and cogging procedures) need models this stage does not have; they are refused with PKW error 18
-instead of pretending to succeed.
+EEPROM read / write and checksum), 894 (motor feedback programming: the selection 890-893/898 it applied is
+recorded). The others (auto-phasing, auto-tuning, encoder output programming, absolute-encoder and cogging
+procedures) need models this stage does not have; they are refused with PKW error 18 instead of pretending to
+succeed. A procedure the manual runs "with disabled positioner" (729, 894, …) is refused with error 17 while enabled.
 """
 
 from __future__ import annotations

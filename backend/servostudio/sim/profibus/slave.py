@@ -26,6 +26,10 @@ SEQUENCE_CHECKSUM_ERROR = 2
 SAVE_SECONDS = 0.1
 SEQUENCE_READ_SECONDS = 0.005
 SEQUENCE_WRITE_SECONDS = 0.02
+FEEDBACK_PROGRAMMING_SECONDS = 0.2
+"""The simulator's duration of PNU 894 (motor feedback programming); the real drive takes about 5 s (L3105)."""
+FEEDBACK_SELECTION = (890, 891, 892, 893, 898)
+"""What PNU 894 applies: encoder input selection and resolution, interpolation, motor feedback, SinCos tracks."""
 
 
 class TtaProSlave:
@@ -36,6 +40,8 @@ class TtaProSlave:
         self.parameters = parameters
         self.plant = plant
         self.double_reply_ak = double_reply_ak
+        self.feedback_programmings: list[dict[int, int]] = []
+        """Every PNU 894 carried out since the drive was built (power cycles too): the selection it applied."""
         self._build(ParameterMemory(parameters), commission=True)
 
     def _build(self, memory: ParameterMemory, commission: bool) -> None:
@@ -55,6 +61,12 @@ class TtaProSlave:
         self.procedures.define(729, Procedure(SAVE_SECONDS, lambda _: _done(memory.save_eeprom)))
         self.procedures.define(780, Procedure(SEQUENCE_READ_SECONDS, lambda n: _done(sequences.read_into_buffer, n)))
         self.procedures.define(781, Procedure(SEQUENCE_WRITE_SECONDS, lambda n: _done(sequences.write, n)))
+        self.procedures.define(894, Procedure(FEEDBACK_PROGRAMMING_SECONDS, lambda _: _done(self._program_feedback)))
+
+    def _program_feedback(self) -> None:
+        """PNU 894: the feedback selection written to 890-893/898 becomes the one the drive uses (L3105). The
+        simulated plant keeps its own sensor: what was applied is recorded, not modelled."""
+        self.feedback_programmings.append({pnu: self.memory.get(pnu) for pnu in FEEDBACK_SELECTION})
 
     def power_cycle(self) -> None:
         memory = ParameterMemory(self.parameters)

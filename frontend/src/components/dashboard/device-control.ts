@@ -1,7 +1,8 @@
 /**
  * Device control (CiA 402): the state from the status word with the strip of the eight states, one button per
  * transition the state allows (manual L2952–3042; enabling is always an explicit click), the mode of operation
- * (active mode and a selector over 0x6060's enumeration) and the NMT commands.
+ * (active mode and a selector over 0x6060's enumeration) and the NMT commands — the last two only where the device
+ * has them (a TTA-PRO on PROFIBUS-DP has neither: its state machine is CiA 402's through its PZD words).
  */
 
 import { enumEditor } from "../editors";
@@ -48,6 +49,10 @@ export interface DeviceControlProps {
   mode: Entry | null;
   activeMode: Bindable<Scalar>;
   activeModeText: Bindable<string>;
+  /** The device has CANopen's NMT (the NMT buttons); a PROFIBUS-DP drive has none. */
+  nmtCommands: boolean;
+  /** The device has CiA 402 modes of operation (0x6060 or 0x6061). */
+  modes: boolean;
   onCommand(command: Command): void;
   onSetMode(raw: number, label: string): void;
   onNmt(command: string, label: string): void;
@@ -65,13 +70,25 @@ export function deviceControl(props: DeviceControlProps): HTMLElement {
       }, ABBREVIATIONS[candidate]))),
       caption("Allowed transitions", 10),
       transitionButtons(props, driveState),
-      caption("Mode of operation", 12),
-      h("div", { class: "toolbar" }, h("span", null, "Active: "),
-        h("span", { class: "mono", "data-testid": "dashboard-mode" }, () => valueOf(props.activeModeText)),
-        props.mode ? modeSelector(props.mode, props) : null),
-      caption("NMT", 12),
-      h("div", { class: "toolbar" }, NMT_COMMANDS.map(([command, label]) =>
-        h("button", { class: "small", onclick: () => props.onNmt(command, label) }, label)))));
+      props.modes ? modeRow(props, caption) : null,
+      props.nmtCommands ? nmtRow(props, caption) : null));
+}
+
+function modeRow(props: DeviceControlProps, caption: (text: string, top: number) => HTMLElement): HTMLElement[] {
+  return [
+    caption("Mode of operation", 12),
+    h("div", { class: "toolbar" }, h("span", null, "Active: "),
+      h("span", { class: "mono", "data-testid": "dashboard-mode" }, () => valueOf(props.activeModeText)),
+      props.mode ? modeSelector(props.mode, props) : null),
+  ];
+}
+
+function nmtRow(props: DeviceControlProps, caption: (text: string, top: number) => HTMLElement): HTMLElement[] {
+  return [
+    caption("NMT", 12),
+    h("div", { class: "toolbar", "data-testid": "dashboard-nmt-commands" }, NMT_COMMANDS.map(([command, label]) =>
+      h("button", { class: "small", onclick: () => props.onNmt(command, label) }, label))),
+  ];
 }
 
 function stateBanner(props: DeviceControlProps, driveState: State<DriveState | null>): HTMLElement {

@@ -2,7 +2,7 @@
 
 import { derive, h } from "../../lib/dom";
 import type { Entry } from "../../lib/od";
-import { formatValue } from "../../lib/values";
+import { formatValue, LIVE_DIGITS } from "../../lib/values";
 import type { LiveCell } from "./model";
 
 export interface MeasurementsProps {
@@ -23,7 +23,7 @@ function readout(entry: Entry, props: MeasurementsProps): HTMLElement {
   // Derived texts: the readout changes only when what it shows does, not at every sample.
   const text = derive(() => {
     const cell = props.cell(entry);
-    return cell.error ? "error" : cell.value ? formatValue(variable, cell.value.raw) : "";
+    return cell.error ? "error" : cell.value ? formatValue(variable, cell.value.raw, LIVE_DIGITS) : "";
   });
   const error = derive(() => props.cell(entry).error ?? "");
   return h("div", { class: "readout", title: `${address} ${variable.description}`, "data-testid": `readout-${address}` },

@@ -1,7 +1,8 @@
 /**
  * Quick test (manual §1.8.19): profile velocity by its objects — acceleration, deceleration and target velocity in
- * their units; Set mode and run checks all three and hands them on, Stop writes target 0 — and, with `motion`, the
- * hold-to-run motions behind the arm switch: PV jog, PP moves, homing (`components/motion/`).
+ * their units; Set mode and run checks all three and hands them on, Stop writes target 0 (when the device has a
+ * profile velocity mode) — and, with `motion`, the hold-to-run motions behind the arm switch: jog, moves, homing
+ * (`components/motion/`), also on a device without CiA 402 modes (the TTA-PRO: through its control word).
  */
 
 import { motionPanel, type MotionPanelProps } from "../motion/motion-panel";
@@ -19,7 +20,8 @@ export interface QuickTestValue {
 export interface QuickTestProps {
   acceleration: Entry | null;
   deceleration: Entry | null;
-  target: Entry;
+  /** The target velocity; null: the device has no profile velocity mode (the TTA-PRO), only the motions. */
+  target: Entry | null;
   /** The drive's value of a field's entry (shown until the user types). */
   value(entry: Entry): Bindable<Scalar>;
   onRun(values: QuickTestValue[]): void;
@@ -38,6 +40,15 @@ interface Field {
 }
 
 export function quickTest(props: QuickTestProps): HTMLElement {
+  return h("section", { class: "panel" },
+    h("h2", null, props.motion ? "Quick test" : "Quick test · profile velocity"),
+    h("div", { class: "panel-body grid", style: { gap: "8px" } },
+      props.target ? profileVelocity(props, props.target) : null,
+      props.motion ? motionPanel(props.motion) : null));
+}
+
+/** The profile velocity fields with Set mode and run / Stop. */
+function profileVelocity(props: QuickTestProps, targetEntry: Entry): HTMLElement[] {
   const field = (entry: Entry | null, label: string, testid: string): Field | null => entry && {
     entry, label,
     editor: numberEditor(entry.variable, {
@@ -45,7 +56,7 @@ export function quickTest(props: QuickTestProps): HTMLElement {
       attrs: { style: { width: "110px" }, "data-testid": testid, "aria-label": label },
     }),
   };
-  const target = field(props.target, "Target velocity", "qt-velocity")!;
+  const target = field(targetEntry, "Target velocity", "qt-velocity")!;
   const fields = [field(props.acceleration, "Acceleration", "qt-acceleration"), field(props.deceleration, "Deceleration", "qt-deceleration"), target]
     .filter((candidate): candidate is Field => candidate !== null);
   const run = () => {
@@ -60,14 +71,12 @@ export function quickTest(props: QuickTestProps): HTMLElement {
   const stop = async () => {
     if (await props.onStop()) target.editor.revert();
   };
-  return h("section", { class: "panel" },
-    h("h2", null, props.motion ? "Quick test" : "Quick test · profile velocity"),
-    h("div", { class: "panel-body grid", style: { gap: "8px" } },
-      h("div", { class: "toolbar" }, fields.map(({ entry, label, editor }) =>
-        h("label", { class: "field" }, `${label} [${entry.variable.unit}]`, editor.element))),
-      h("div", { class: "toolbar" },
-        h("button", { class: "primary", "data-testid": "qt-run", onclick: run }, "Set mode and run"),
-        h("button", { "data-testid": "qt-stop", onclick: () => void stop() }, "Stop (target 0)"),
-        h("span", { class: "muted" }, "Runs only while the drive is in Operation enabled.")),
-      props.motion ? motionPanel(props.motion) : null));
+  return [
+    h("div", { class: "toolbar" }, fields.map(({ entry, label, editor }) =>
+      h("label", { class: "field" }, `${label} [${entry.variable.unit}]`, editor.element))),
+    h("div", { class: "toolbar" },
+      h("button", { class: "primary", "data-testid": "qt-run", onclick: run }, "Set mode and run"),
+      h("button", { "data-testid": "qt-stop", onclick: () => void stop() }, "Stop (target 0)"),
+      h("span", { class: "muted" }, "Runs only while the drive is in Operation enabled.")),
+  ];
 }

@@ -134,3 +134,12 @@ export function motionText(motion: Motion | null): string {
   const reason = motion.reason ? ` — ${motion.reason}` : "";
   return `${what} ${motion.state}${where}${reason}`;
 }
+
+/**
+ * The homing method the page shows and starts: the one picked when the device has it, else the device's first
+ * (CiA 402's 35 is no TTA-PRO configuration); the picked one while the methods are not known yet.
+ */
+export function homingChoice(methods: Pick<HomingMethod, "method">[], picked: string): string {
+  if (methods.length === 0 || methods.some((item) => String(item.method) === picked)) return picked;
+  return String(methods[0].method);
+}

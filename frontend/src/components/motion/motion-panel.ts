@@ -1,12 +1,12 @@
 /**
- * Quick test · motion (manual §1.8.19): the arm switch, a profile-velocity jog, profile-position moves (relative or
- * absolute), homing with the device's methods and the manual's description of each, the axis's limits (small by
- * default, raised here) and what the last motion did. Every button is hold-to-run (`hold-button.ts`).
+ * Quick test · motion (manual §1.8.19): the arm switch, a jog, moves (relative or absolute), homing with the
+ * device's methods and the manual's description of each (in CiA 402's modes PV, PP, HM; on a TTA-PRO by its control
+ * word), the axis's limits (small by default, raised here) and what the last motion did. Every button is hold-to-run (`hold-button.ts`).
  */
 
 import { armSwitch } from "./arm-switch";
 import { holdButton } from "./hold-button";
-import { motionText, type QuickMotion } from "./model";
+import { homingChoice, motionText, type QuickMotion } from "./model";
 import { h, state, valueOf, type Bindable, type State } from "../../lib/dom";
 
 export interface MotionPanelProps {
@@ -16,6 +16,8 @@ export interface MotionPanelProps {
   busy: Bindable<boolean>;
   onArm(): void;
   onRelease(): void;
+  /** The motions run in CiA 402 modes (PV, PP, HM) and say so; false: by control-word bits (the TTA-PRO). */
+  modes?: boolean;
 }
 
 function numberField(label: string, testid: string, value: State<string>, width = "90px"): HTMLElement {
@@ -40,9 +42,9 @@ export function motionPanel(props: MotionPanelProps): HTMLElement {
     h("div", { class: "toolbar" },
       armSwitch(props),
       h("span", { class: "muted", "data-testid": "motion-state" }, () => motionText(model.motion.val))),
-    jogRow(model, locked),
-    moveRow(model, locked),
-    homingRow(model, locked),
+    jogRow(model, locked, props.modes ? "Jog (PV)" : "Jog"),
+    moveRow(model, locked, props.modes ? "Move (PP)" : "Move"),
+    homingRow(model, locked, props.modes ? "Homing (HM)" : "Homing"),
     limitsRow(model),
     () => (model.error.val ? h("div", { class: "message error", "data-testid": "motion-error" }, model.error.val) : null));
 }
@@ -58,7 +60,7 @@ function held(model: QuickMotion, locked: () => boolean, label: string, testid: 
   });
 }
 
-function jogRow(model: QuickMotion, locked: () => boolean): HTMLElement {
+function jogRow(model: QuickMotion, locked: () => boolean, title: string): HTMLElement {
   const velocity = state("60");
   const jog = (sign: number) => () => {
     const value = parsed("Velocity", velocity.rawVal);
@@ -67,13 +69,13 @@ function jogRow(model: QuickMotion, locked: () => boolean): HTMLElement {
     return null;
   };
   return h("div", { class: "toolbar" },
-    h("strong", null, "Jog (PV)"),
+    h("strong", null, title),
     numberField("Velocity [rpm]", "jog-velocity", velocity),
     held(model, locked, "◀ Hold to jog −", "jog-minus", jog(-1)),
     held(model, locked, "Hold to jog + ▶", "jog-plus", jog(1)));
 }
 
-function moveRow(model: QuickMotion, locked: () => boolean): HTMLElement {
+function moveRow(model: QuickMotion, locked: () => boolean, title: string): HTMLElement {
   const distance = state("4096");
   const velocity = state("");
   const absolute = state(false);
@@ -86,7 +88,7 @@ function moveRow(model: QuickMotion, locked: () => boolean): HTMLElement {
     return null;
   };
   return h("div", { class: "toolbar" },
-    h("strong", null, "Move (PP)"),
+    h("strong", null, title),
     numberField("Distance [user units]", "move-distance", distance, "110px"),
     h("label", { class: "field" },
       h("input", { type: "checkbox", "data-testid": "move-absolute", checked: absolute, onchange: (event: Event) => (absolute.val = (event.target as HTMLInputElement).checked) }),
@@ -95,23 +97,24 @@ function moveRow(model: QuickMotion, locked: () => boolean): HTMLElement {
     held(model, locked, "Hold to move", "move-run", move));
 }
 
-function homingRow(model: QuickMotion, locked: () => boolean): HTMLElement {
+function homingRow(model: QuickMotion, locked: () => boolean, title: string): HTMLElement {
   const method = state("35");
   const velocity = state("");
-  const described = () => model.methods.val.find((item) => String(item.method) === method.val)?.description ?? "";
+  const chosen = () => homingChoice(model.methods.val, method.val);
+  const described = () => model.methods.val.find((item) => String(item.method) === chosen())?.description ?? "";
   const home = () => {
     const speed = parsed("Velocity", velocity.rawVal, true);
     if (typeof speed === "string") return speed;
-    void model.home(Number(method.rawVal), speed);
+    void model.home(Number(homingChoice(model.methods.rawVal, method.rawVal)), speed);
     return null;
   };
   const options = () => model.methods.val.map((item) =>
     h("option", { value: String(item.method), title: item.description }, `${item.method} — ${item.description}`));
   return h("div", { class: "grid", style: { gap: "4px" } },
     h("div", { class: "toolbar" },
-      h("strong", null, "Homing (HM)"),
+      h("strong", null, title),
       h("label", { class: "field" }, "Method",
-        h("select", { "data-testid": "homing-method", style: { maxWidth: "280px" }, value: method, onchange: (event: Event) => (method.val = (event.target as HTMLSelectElement).value) }, options)),
+        h("select", { "data-testid": "homing-method", style: { maxWidth: "280px" }, value: chosen, onchange: (event: Event) => (method.val = (event.target as HTMLSelectElement).value) }, options)),
       numberField("Search speed [rpm]", "homing-velocity", velocity),
       held(model, locked, "Hold to home", "homing-run", home)),
     h("span", { class: "muted", "data-testid": "homing-description" }, described));

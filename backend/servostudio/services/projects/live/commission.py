@@ -5,8 +5,9 @@ Download makes each drive hold the project's values: a drive freshly loaded with
 values and the dictionary default of everything else (docs/projects.md §4), so the files sent are *complete* — every
 object drive and project exchange, with its project value — and go through ``services.backup.restore_file``
 (validated as a whole before the first write, written, read back, stored to flash). Objects the project gives no
-value (no default, not set) are not sent and keep the drive's value; the report counts them. SEQUENCE.TXT is
-restored as the project holds it (an empty file clears the drive's sequences).
+value (no default, not set) are not sent and keep the drive's value; the report counts them. A sequence file
+(SEQUENCE.TXT, a TTA-PRO's TTASEQ.TXT) is restored as the project holds it (an empty file clears the drive's
+sequences).
 
 Upload reads the drives' files with ``services.backup.backup_drive`` into a scratch directory, checks them against
 the axis's dictionary, and then replaces the axis files of every uploaded axis in one project change.
@@ -172,8 +173,8 @@ def _download(
     for kind in drive_file_kinds(drive):
         if cancel is not None and cancel.requested:
             return  # files not started are left out of the report
-        if kind is FileKind.SEQUENCE:
-            source = copy.directory / layout.SEQUENCE
+        if kind.save_type is None:  # a sequence file: the project keeps it whole
+            source = copy.directory / kind.value
             if not source.is_file():
                 continue
             result = restore_file(drive, source, kind, relay, cancel=cancel).as_dict()

@@ -15,8 +15,7 @@ from html.parser import HTMLParser
 from pathlib import Path
 from typing import Any
 
-from tests.services.procedures.conftest import open_bench
-from tests.services.procedures.test_procedures_plants import commission
+from tests.support.procedure_bench import commission, open_bench
 
 from servostudio.od import builtin_library
 from servostudio.services.audit import Actor, AuditLog, acting_as
@@ -27,7 +26,7 @@ from servostudio.services.projects import ProjectService
 from servostudio.services.scope import Capture, CaptureDefinition, CaptureStore
 from servostudio.services.scope.service import identity_of
 
-DEMO = Path(__file__).parents[3] / "projects" / "demo"
+DEMO = Path(__file__).resolve().parents[2] / "projects" / "demo"
 SEED = 101
 #: the saved frequency response's name and its plant fit (values a test can find in the report)
 BODE_NAME = "plant sweep"

@@ -1,0 +1,76 @@
+"""A server of the tool in this process with a simulated TTA-PRO line opened as bus ``pb`` and a project ``pb``
+whose axis X is the TTA-PRO at station 5, for the browser tests that judge the page on the simulated slave itself
+(its counter, its state, its EEPROM): the line is the simulator's TCP byte stream (``profibus:tcp:HOST:PORT``),
+reached by the project's own DP master."""
+
+from __future__ import annotations
+
+import threading
+import time
+from collections.abc import Iterator
+from contextlib import contextmanager
+from dataclasses import dataclass
+from pathlib import Path
+
+import httpx
+import uvicorn
+from tests.support.access import passwordless
+from tests.support.live_server import free_port, private_ui_settings
+from tests.support.profibus_line import TtaProLine, ttapro_line
+
+from servostudio.api.app import Settings, create_app
+from servostudio.sim.drive.statemachine import State
+
+NODE = 5
+
+
+@dataclass(frozen=True)
+class TtaProServer:
+    url: str
+    line: TtaProLine
+
+    def api(self, method: str, path: str, **kwargs) -> dict:
+        answer = httpx.request(method, f"{self.url}/api{path}", timeout=15, **kwargs)
+        assert answer.is_success, answer.text
+        return answer.json()
+
+    def counter(self) -> int:
+        """The simulated drive's position counter (what PNU 774 reads)."""
+        with self.line.line.lock:
+            drive = self.line.slaves[NODE].drive
+            return drive.units.position(drive.axis.position)
+
+    def drive_state(self) -> State:
+        with self.line.line.lock:
+            return self.line.slaves[NODE].drive.device.state
+
+
+@contextmanager
+def ttapro_ui_server(root: Path) -> Iterator[TtaProServer]:
+    """The server (the private UI build when ``SERVOSTUDIO_TEST_UI`` names one) on a free port, stopped on exit."""
+    (root / "projects").mkdir()
+    port = free_port()
+    data = passwordless(root / "data")
+    settings = Settings(projects_dir=root / "projects", data_dir=data, buses=(), port=port, **private_ui_settings())
+    with ttapro_line(NODE) as line:
+        running = uvicorn.Server(uvicorn.Config(create_app(settings), host="127.0.0.1", port=port, log_level="warning"))
+        thread = threading.Thread(target=running.run, name="ttapro-ui-server", daemon=True)
+        thread.start()
+        deadline = time.monotonic() + 30
+        while not running.started:
+            assert time.monotonic() < deadline and thread.is_alive(), "the server did not start"
+            time.sleep(0.05)
+        try:
+            yield _with_project(TtaProServer(f"http://127.0.0.1:{port}", line))
+        finally:
+            running.should_exit = True
+            thread.join(timeout=15)
+
+
+def _with_project(server: TtaProServer) -> TtaProServer:
+    server.api("POST", "/buses", json={"spec": server.line.spec, "id": "pb"})
+    bus = {"name": "pb", "interface": server.line.spec}
+    created = server.api("POST", "/projects", json={"name": "pb", "buses": [bus]})
+    axis = {"name": "X", "device": "ttapro", "node_id": NODE, "bus": "pb", "revision": created["revision"]}
+    server.api("POST", "/projects/pb/axes", json=axis)
+    return server
