@@ -43,7 +43,7 @@ def test_a_job_with_some_nodes_failed_is_partial_and_names_them(bus, tmp_path):
     restore = finished(start_restore(jobs, bus, [tmp_path], str(tmp_path), [1, 2], None, store=False))
     assert restore.state == "partial"
     assert [item["ok"] for item in restore.result["1"]] == [True]
-    assert "no DRIVEPAR.TXT, USER_PAR.TXT or SEQUENCE.TXT for node 2" in restore.result["2"]["error"]
+    assert "node2/: none of DRIVEPAR.TXT, USER_PAR.TXT, SEQUENCE.TXT for node 2" in restore.result["2"]["error"]
     assert restore.error.startswith("1 of 2 failed: node 2:")
 
 

@@ -28,7 +28,7 @@ from servostudio.drive.nmt import NmtCommand
 from servostudio.drive.profiles import profile_for
 from servostudio.errors import ServoStudioError
 from servostudio.formats.textfile import FILE_ENCODING, write_text_atomic
-from servostudio.services.backup import BackupError, FileKind, RestoreValidationError, profile_file_kinds
+from servostudio.services.backup import BackupError, FileKind, RestoreValidationError, no_files, profile_file_kinds
 from servostudio.services.scan import NothingFound
 
 SCAN_HINT_HEADER = "x-scan-hint"
@@ -182,9 +182,10 @@ def restore(args: argparse.Namespace, bus: ServerBus) -> object:
 
     def one(node: int, device: str | None) -> list[dict[str, Any]]:
         folder = source / f"node{node}"
-        kinds = [kind for kind in profile_file_kinds(profile_for(device)) if (folder / kind.value).is_file()]
+        possible = profile_file_kinds(profile_for(device))
+        kinds = [kind for kind in possible if (folder / kind.value).is_file()]
         if not kinds:
-            raise RestoreValidationError(f"node{node}/: no DRIVEPAR.TXT, USER_PAR.TXT or SEQUENCE.TXT for node {node}")
+            raise no_files(node, possible)
         return [_upload(args, bus, node, kind, folder / kind.value, store) for kind in kinds]
 
     return _collected(_per_node(nodes, one))

@@ -320,14 +320,19 @@ def restore_drive(
     Files not started when a cancellation comes are left out of the result."""
     chosen = list(kinds or [kind for kind in drive_file_kinds(drive) if (directory / kind.value).is_file()])
     if not chosen:
-        names = ", ".join(kind.value for kind in drive_file_kinds(drive))
-        raise RestoreValidationError(f"node{drive.node}/: none of {names} for node {drive.node}")
+        raise no_files(drive.node, drive_file_kinds(drive))
     results = []
     for kind in chosen:
         if cancel is not None and cancel.requested:
             break
         results.append(restore_file(drive, directory / kind.value, kind, progress, store, cancel))
     return results
+
+
+def no_files(node: int, kinds: Iterable[FileKind]) -> RestoreValidationError:
+    """A restore of a folder without any of the device's files: the refusal names the files it looked for."""
+    names = ", ".join(kind.value for kind in kinds)
+    return RestoreValidationError(f"node{node}/: none of {names} for node {node}")
 
 
 def drive_file_kinds(drive: Drive) -> list[FileKind]:
