@@ -81,7 +81,7 @@ def test_a_restore_is_refused_while_the_drive_is_enabled_and_writes_nothing(clie
             refused = client.put(f"{NODE}/files/TTAPAR.TXT", content=upload)
             assert refused.status_code == 409, refused.text
             assert refused.json()["detail"] == (
-                "node 5: ttapro stores parameters only with the drive disabled; disable it first — nothing was written"
+                "node 5: TTA-PRO stores parameters only with the drive disabled; disable it first — nothing was written"
             )
             assert client.get(f"{NODE}/state").json()["state"] == "OPERATION ENABLED"  # the restore left it so
         finally:

@@ -83,7 +83,7 @@ def test_an_enabled_ttapro_is_refused_and_nothing_is_stored(client, line):
             client.put(f"{TTA}/state", json={"target": "switch-on-disabled"})
     assert refused.status_code == 409, refused.text
     assert refused.json()["detail"] == (
-        "node 5: ttapro stores parameters only with the drive disabled; disable it first — nothing was written"
+        "node 5: TTA-PRO stores parameters only with the drive disabled; disable it first — nothing was written"
     )
     with line.line.lock:
         slave.power_cycle()

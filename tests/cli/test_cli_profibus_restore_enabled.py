@@ -56,7 +56,7 @@ def test_a_restore_of_an_enabled_ttapro_is_refused_and_writes_nothing(server, li
             holder.kill()
     assert restore.returncode == 3, restore.stderr
     assert restore.stderr.strip().splitlines()[-1] == (
-        "error: node 5: ttapro stores parameters only with the drive disabled; disable it first — nothing was written"
+        "error: node 5: TTA-PRO stores parameters only with the drive disabled; disable it first — nothing was written"
     )
     assert restore.stdout == ""
     assert memory.get(730) == before

@@ -92,6 +92,6 @@ def test_store_of_an_enabled_ttapro_is_refused_and_stores_nothing(server, line, 
         holder.communicate(timeout=30)
     assert code == 3 and out is None
     assert error.strip().splitlines()[-1] == (
-        "error: node 5: ttapro stores parameters only with the drive disabled; disable it first — nothing was written"
+        "error: node 5: TTA-PRO stores parameters only with the drive disabled; disable it first — nothing was written"
     )
     assert survives_power_cycle(line, kept)

@@ -7,7 +7,8 @@ import itertools
 import threading
 import time
 
-from servostudio.drive.sync import SYNC_COB_ID, SyncProducer
+from servostudio.drive.link import BusLink
+from servostudio.drive.sync import MAX_AHEAD, SYNC_COB_ID, SyncProducer
 
 PERIOD = 0.01
 STALL = 0.045  # 4.5 periods
@@ -41,3 +42,44 @@ def test_a_held_up_producer_skips_the_slots_it_missed_instead_of_bursting():
     assert producer.skipped >= 3  # the slots the stall covered are left out, not sent late
     assert numbers == list(range(len(numbers))) and len(numbers) >= len(producer.sent)  # SYNC k is the k-th sent
     assert all(frame == (SYNC_COB_ID, b"") for frame in link.frames)
+
+
+class CuttableBus:
+    """A bus that carries the SYNCs until it is cut; nothing ever answers them."""
+
+    def __init__(self) -> None:
+        self.sent: list[int] = []
+        self.cut = threading.Event()
+
+    def receive_frames(self, timeout: float) -> list:
+        if self.cut.wait(timeout):
+            raise OSError("connection closed by the server")
+        return []
+
+    def send_frame(self, cob_id: int, data: bytes) -> None:
+        self.sent.append(cob_id)
+
+    def shutdown(self) -> None:
+        pass
+
+
+def test_a_link_lost_while_the_producer_waits_for_answers_ends_it_at_once():
+    """The producer held back by its consumers sends nothing, so no failed send tells it of the cut: it must see the
+    link go down itself, or a capture whose answers stopped with the link waits for its timeout."""
+    bus = CuttableBus()
+    link = BusLink("cuttable", lambda: bus)  # type: ignore[arg-type, return-value]
+    assert link.start(wait=1.0)
+    producer = SyncProducer(link, PERIOD, answered=lambda: 0).start()
+    deadline = time.monotonic() + 2.0
+    while len(bus.sent) < MAX_AHEAD and time.monotonic() < deadline:
+        time.sleep(PERIOD)
+    time.sleep(3 * PERIOD)  # held back: MAX_AHEAD SYNCs out, none answered
+    assert len(bus.sent) == MAX_AHEAD and producer.error is None
+    bus.cut.set()
+    deadline = time.monotonic() + 1.0
+    while producer.error is None and time.monotonic() < deadline:
+        time.sleep(PERIOD)
+    producer.stop()
+    link.close()
+    assert producer.error is not None and "not connected" in producer.error
+    assert "connection closed by the server" in producer.error

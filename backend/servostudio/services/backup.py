@@ -283,8 +283,13 @@ def _unwritable_text(text: str) -> bool:
 
 
 def _header(drive: Drive, kind: FileKind) -> str:
-    device = drive.dictionary.product_name if drive.dictionary else drive.profile.device
-    return f"{kind.value} of node {drive.node} ({device}), Servo Studio backup {time.strftime('%Y-%m-%d %H:%M:%S')}"
+    stamp = time.strftime("%Y-%m-%d %H:%M:%S")
+    return f"{kind.value} of node {drive.node} ({_device_name(drive)}), Servo Studio backup {stamp}"
+
+
+def _device_name(drive: Drive) -> str:
+    """The product as its dictionary names it (``TTA-PRO``), else the profile's key."""
+    return drive.dictionary.product_name if drive.dictionary else drive.profile.device
 
 
 def backup_drive(
@@ -554,7 +559,7 @@ def _check_can_store(drive: Drive, store: bool) -> None:
         state = decode_state(int(drive.read("statusword").raw))
         if state is State.OPERATION_ENABLED:
             raise DriveNotDisabled(
-                f"node {drive.node}: {drive.profile.device} stores parameters only with the drive "
+                f"node {drive.node}: {_device_name(drive)} stores parameters only with the drive "
                 "disabled; disable it first — nothing was written"
             )
 
