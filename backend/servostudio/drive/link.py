@@ -91,13 +91,22 @@ class BusLink:
         return self._connected.wait(timeout)
 
     # -- frames ------------------------------------------------------------------------------------------------
+    def check_connected(self) -> None:
+        """Raise `LinkDownError` (saying why) unless the link is up: for a sender that waits between its frames
+        (the SYNC producer held back by its consumers), whose next send would come too late to tell of a cut."""
+        if not self.connected:
+            raise self._down()
+
+    def _down(self) -> LinkDownError:
+        if self.closed:
+            return LinkDownError(f"bus {self.name} was closed")
+        detail = f" ({self.last_error})" if self.last_error else ""
+        return LinkDownError(f"bus {self.name} is not connected{detail}")
+
     def send(self, cob_id: int, data: bytes) -> None:
         bus = self._bus
         if bus is None or not self.connected:
-            detail = f" ({self.last_error})" if self.last_error else ""
-            raise LinkDownError(
-                f"bus {self.name} was closed" if self.closed else f"bus {self.name} is not connected{detail}"
-            )
+            raise self._down()
         if self._held is not None and threading.current_thread() is self._thread:
             self._held.append((cob_id, data))  # leaves with the rest of the batch's answers
             return

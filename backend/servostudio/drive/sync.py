@@ -96,10 +96,9 @@ class SyncProducer:
             delay = start + slot * self.period_s - time.monotonic()
             if delay > 0 and self._stop.wait(delay):
                 return
-            while self._answered is not None and k - self._answered() >= MAX_AHEAD:
-                if self._stop.wait(HOLD_SECONDS):
-                    return
             try:
+                if not self._wait_for_answers(k):
+                    return
                 if self._before is not None:
                     self._before(k)
                 self.link.send(SYNC_COB_ID, b"")
@@ -111,6 +110,16 @@ class SyncProducer:
             self.slots.append(slot)
             k += 1
             slot = max(slot + 1, math.ceil((sent - start) / self.period_s + 0.5))
+
+    def _wait_for_answers(self, k: int) -> bool:
+        """Until fewer than ``MAX_AHEAD`` SYNCs are unanswered; False when stopped meanwhile. A link lost meanwhile
+        raises `LinkDownError`: the answers will never come, and no send of this thread would tell of the cut — a
+        capture would wait for its timeout instead of failing at once."""
+        while self._answered is not None and k - self._answered() >= MAX_AHEAD:
+            self.link.check_connected()
+            if self._stop.wait(HOLD_SECONDS):
+                return False
+        return True
 
 
 def announce_cycle(drive: Drive, period_s: float) -> int | None:

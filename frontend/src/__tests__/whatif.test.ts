@@ -104,21 +104,3 @@ describe("markers", () => {
     expect(found.resonance_hz! / resonance).toBeCloseTo(1, 1);
   });
 });
-
-describe("speed of a what-if update", () => {
-  it("a slider change (closed loop on 400 points, markers, 0.1 s step) takes well under 50 ms", () => {
-    const plant = rigidPlant(FIT, logspace(1, 2000, 400));
-    const runs = 50;
-    const started = performance.now();
-    for (let n = 0; n < runs; n++) {
-      const params = tuned(30 + n);
-      const loops = loopResponses(plant, params);
-      bandwidth(loops.closedLoop);
-      margins(loops.openLoop);
-      stepResponse(params, FIT, 0.1);
-    }
-    const perUpdate = (performance.now() - started) / runs;
-    console.log(`what-if update: ${perUpdate.toFixed(3)} ms (400 points, 400-period step)`);
-    expect(perUpdate).toBeLessThan(50);
-  });
-});
