@@ -5,6 +5,7 @@ link is cut, it stops at once with the link's error."""
 from __future__ import annotations
 
 import itertools
+import re
 import threading
 import time
 
@@ -88,4 +89,8 @@ def test_a_link_lost_while_the_producer_waits_for_answers_ends_it_at_once():
         time.sleep(PERIOD)
     producer.stop()
     link.close()
-    assert producer.error is not None and "bus cuttable is not connected" in producer.error
+    assert producer.error is not None
+    # with the link's reason: recorded before the link reads as down (a later reconnection attempt may have renewed it)
+    assert re.search(
+        r"bus cuttable is not connected \((connection closed by the server|connection refused)\)", producer.error
+    )

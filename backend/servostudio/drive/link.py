@@ -207,9 +207,12 @@ class BusLink:
         self._notify(True, "connected")
 
     def _link_lost(self, reason: str) -> None:
+        """The reason is recorded before the link reads as down, so whoever sees it down (`check_connected`, a
+        send) is told why."""
+        if self._connected.is_set():
+            self.last_error = reason
         if self._drop_bus():
             log.warning("bus %s lost: %s", self.name, reason)
-            self.last_error = reason
             self._notify(False, reason)
 
     def _drop_bus(self) -> bool:
