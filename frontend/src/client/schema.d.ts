@@ -2595,10 +2595,12 @@ export interface components {
             device: string;
             /**
              * Features
-             * @description the services the device has, of scope, procedures, frequency_response, sequences, io: what a client offers it (the server refuses the others)
+             * @description the services the device has, of scope, current_loop, phasing, auto_tuning, frequency_response, sequences, io: what a client offers it (the server refuses the others)
              * @example [
              *       "scope",
-             *       "procedures",
+             *       "current_loop",
+             *       "phasing",
+             *       "auto_tuning",
              *       "frequency_response",
              *       "sequences",
              *       "io"

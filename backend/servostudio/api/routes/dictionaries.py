@@ -96,9 +96,9 @@ class DictionaryModel(DictionarySummary):
         examples=[["DRIVEPAR.TXT", "USER_PAR.TXT", "SEQUENCE.TXT"], ["TTAPAR.TXT", "TTASEQ.TXT"]],
     )
     features: list[str] = Field(
-        description="the services the device has, of scope, procedures, frequency_response, sequences, io: what a "
-        "client offers it (the server refuses the others)",
-        examples=[["scope", "procedures", "frequency_response", "sequences", "io"], []],
+        description="the services the device has, of scope, current_loop, phasing, auto_tuning, frequency_response, "
+        "sequences, io: what a client offers it (the server refuses the others)",
+        examples=[["scope", "current_loop", "phasing", "auto_tuning", "frequency_response", "sequences", "io"], []],
     )
     store: str | None = Field(
         description="what storing the parameters (POST …/store) writes on this device, in its dictionary's words",
