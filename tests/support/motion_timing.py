@@ -36,15 +36,16 @@ STANDSTILL = 0.5  # rad/s, the simulated drive's own standstill threshold (``STA
 
 
 class InProcessServer:
-    """``servostudio serve`` with simulated drives, on a thread of this process (stopped by ``close``)."""
+    """``servostudio serve`` with simulated drives (``buses``: the ``sim`` bus by default), on a thread of this
+    process (stopped by ``close``)."""
 
-    def __init__(self, root: Path) -> None:
+    def __init__(self, root: Path, buses: tuple[str, ...] = ("sim",)) -> None:
         self.port = free_port()
         self.url = f"http://127.0.0.1:{self.port}"
         settings = Settings(
             projects_dir=root / "projects",
             data_dir=passwordless(root / "data"),
-            buses=("sim",),
+            buses=buses,
             port=self.port,
             **private_ui_settings(),
         )

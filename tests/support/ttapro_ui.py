@@ -5,20 +5,15 @@ reached by the project's own DP master."""
 
 from __future__ import annotations
 
-import threading
-import time
 from collections.abc import Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 
 import httpx
-import uvicorn
-from tests.support.access import passwordless
-from tests.support.live_server import free_port, private_ui_settings
+from tests.support.motion_timing import InProcessServer
 from tests.support.profibus_line import TtaProLine, ttapro_line
 
-from servostudio.api.app import Settings, create_app
 from servostudio.sim.drive.statemachine import State
 
 NODE = 5
@@ -48,23 +43,12 @@ class TtaProServer:
 @contextmanager
 def ttapro_ui_server(root: Path) -> Iterator[TtaProServer]:
     """The server (the private UI build when ``SERVOSTUDIO_TEST_UI`` names one) on a free port, stopped on exit."""
-    (root / "projects").mkdir()
-    port = free_port()
-    data = passwordless(root / "data")
-    settings = Settings(projects_dir=root / "projects", data_dir=data, buses=(), port=port, **private_ui_settings())
     with ttapro_line(NODE) as line:
-        running = uvicorn.Server(uvicorn.Config(create_app(settings), host="127.0.0.1", port=port, log_level="warning"))
-        thread = threading.Thread(target=running.run, name="ttapro-ui-server", daemon=True)
-        thread.start()
-        deadline = time.monotonic() + 30
-        while not running.started:
-            assert time.monotonic() < deadline and thread.is_alive(), "the server did not start"
-            time.sleep(0.05)
+        running = InProcessServer(root, buses=())
         try:
-            yield _with_project(TtaProServer(f"http://127.0.0.1:{port}", line))
+            yield _with_project(TtaProServer(running.url, line))
         finally:
-            running.should_exit = True
-            thread.join(timeout=15)
+            running.close()
 
 
 def _with_project(server: TtaProServer) -> TtaProServer:
