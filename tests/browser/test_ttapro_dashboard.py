@@ -29,7 +29,9 @@ HERE = "128"  # PNU 766 0x80: home on the current position, counter set to PNU 7
 
 @pytest.fixture(scope="module")
 def server(tmp_path_factory) -> Iterator[TtaProServer]:
-    with ttapro_ui_server(tmp_path_factory.mktemp("ttapro-ui")) as running:
+    # the hold's timing is test_jog_hold.py's: here a loaded host (CI: the held jog expired while the drive enabled)
+    # must not end the jog before the page shows it
+    with ttapro_ui_server(tmp_path_factory.mktemp("ttapro-ui"), hold_timeout=1.0) as running:
         yield running
 
 

@@ -41,10 +41,13 @@ class TtaProServer:
 
 
 @contextmanager
-def ttapro_ui_server(root: Path) -> Iterator[TtaProServer]:
-    """The server (the private UI build when ``SERVOSTUDIO_TEST_UI`` names one) on a free port, stopped on exit."""
+def ttapro_ui_server(root: Path, hold_timeout: float | None = None) -> Iterator[TtaProServer]:
+    """The server (the private UI build when ``SERVOSTUDIO_TEST_UI`` names one) on a free port, stopped on exit;
+    ``hold_timeout`` replaces the hold-to-run watchdog's 0.1 s for a test that is not about its timing."""
     with ttapro_line(NODE) as line:
         running = InProcessServer(root, buses=())
+        if hold_timeout is not None:
+            running.state.motion.motions.holds.timeout = hold_timeout
         try:
             yield _with_project(TtaProServer(running.url, line))
         finally:
