@@ -74,6 +74,8 @@ def test_the_valid_file_loads() -> None:
         ("Bits.8-15=high", "Bits.0-3=high", "test.pnu:23: [PNU828] bits 0..3 overlap 'low'"),
         ("Enum.1=one", "Enum.-1=one", "test.pnu:21: [PNU828] Enum value -1 is outside 0..65535"),
         ("Name=Mapping\n", "", "test.pnu:15: [PNU828] Name is missing"),
+        ("Save=E", "Save=E\nRepeatable=yes", "test.pnu:13: [PNU700] Repeatable=yes needs Procedure=yes"),
+        ("Save=E", "Save=E\nProcedure=yes\nRepeatable=1", "test.pnu:14: [PNU700] Repeatable must be yes or no"),
     ],
 )
 def test_each_broken_rule_names_file_line_section_and_reason(old: str, new: str, message: str) -> None:
@@ -100,6 +102,7 @@ def parameters(draw, pnu: int) -> dict:
     low, high = sorted(draw(st.lists(st.integers(*TYPES[kind]), min_size=2, max_size=2)))
     indices = draw(st.none() | st.integers(1, 4))
     count = indices or 1
+    procedure = draw(st.booleans())
     return {
         "pnu": pnu,
         "Name": draw(texts.filter(bool)),
@@ -113,6 +116,8 @@ def parameters(draw, pnu: int) -> dict:
         "Group": draw(texts),
         "Unit": draw(texts),
         "Derived": draw(texts),
+        "Procedure": procedure,
+        "Repeatable": procedure and draw(st.booleans()),
     }
 
 
@@ -125,6 +130,7 @@ def render(device: int, specs: list[dict]) -> str:
         lines.append("Default=" + ", ".join(str(value) for value in spec["Default"]))
         if spec["Index"]:
             lines.append(f"Index=0..{spec['Index'] - 1}")
+        lines += [f"{flag}=yes" for flag in ("Procedure", "Repeatable") if spec[flag]]
     return "\n".join(lines) + "\n"
 
 
@@ -150,6 +156,7 @@ def test_any_parameter_list_reads_back_from_its_text(drawn: tuple[int, list[dict
         assert [parameter.default_at(index) for index in parameter.index_range] == spec["Default"]
         assert (parameter.group, parameter.unit, parameter.derived) == (spec["Group"], spec["Unit"], spec["Derived"])
         assert len(parameter.index_range) == (spec["Index"] or 1)
+        assert (parameter.procedure, parameter.repeatable) == (spec["Procedure"], spec["Repeatable"])
 
 
 # -- mutated files --------------------------------------------------------------------------------------------

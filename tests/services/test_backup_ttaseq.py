@@ -5,7 +5,10 @@ through the project's own DP master over the simulated line's TCP stream, the ro
 
 from __future__ import annotations
 
+import contextlib
 import random
+import threading
+import time
 from collections.abc import Iterator
 from pathlib import Path
 
@@ -152,3 +155,41 @@ def test_a_sequence_without_every_field_is_refused(drive: Drive) -> None:
 
 def _body(path: Path) -> list[str]:
     return [text for text in path.read_text().splitlines() if not text.startswith(";")]
+
+
+def test_a_station_that_keeps_leaving_data_exchange_costs_time_not_the_table(
+    drive: Drive, line: ProfibusLine, tmp_path: Path
+) -> None:
+    """A loaded host that stalls the master past the DP watchdog: each expiry drops the station out of data exchange
+    in the middle of a buffer procedure (780 / 781), which is run again once the station is parameterised again."""
+    slave = line.slaves[ADDRESS]
+    rng = random.Random(3)
+    table = {number: random_sequence(rng, number) for number in (4, 5)}
+    load_eeprom(slave.sequences, table)
+    with _watchdog_expiring_every(line, 0.4) as drops:
+        backup_file(drive, tmp_path / "TTASEQ.TXT")
+        load_eeprom(slave.sequences, {5: {783: 5}})
+        result = restore_text(drive, (tmp_path / "TTASEQ.TXT").read_text(), FileKind.TTASEQ)
+    assert result.ok and len(drops) >= 3, (result.as_dict(), drops)
+    assert eeprom_table(slave.sequences) == table and slave.sequences.checksum_valid
+
+
+@contextlib.contextmanager
+def _watchdog_expiring_every(line: ProfibusLine, seconds: float) -> Iterator[list[float]]:
+    """Drop every station of the line out of data exchange every ``seconds``; the instants it did."""
+    stop, drops = threading.Event(), []
+
+    def expire() -> None:
+        while not stop.wait(seconds):
+            with line.lock:
+                for slave in line.slaves.values():
+                    slave.station._leave_data_exchange()
+            drops.append(time.monotonic())
+
+    thread = threading.Thread(target=expire, daemon=True)
+    thread.start()
+    try:
+        yield drops
+    finally:
+        stop.set()
+        thread.join()

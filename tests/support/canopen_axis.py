@@ -137,7 +137,13 @@ class Axis:
 
     def settle(self) -> None:
         """Let the drive sample the last control word before the next one: it reads the control word once per
-        control period, so two RPDOs in the same period would hide a pulse. Two SYNC status words are enough."""
+        control period, so two RPDOs in the same period would hide a pulse.
+
+        An SDO read first is the barrier: its answer comes after the drive took the RPDO off the bus (one stream,
+        in order), so the two SYNC status words after it answer SYNCs the drive ran its control periods up to
+        with that control word. Status words alone are not enough on a loaded host: both may answer SYNCs that
+        were queued before the RPDO, and the next RPDO then lands in the same period (CI lost a set-point so)."""
+        self.read(0x6041)
         self.node.check_statusword()
         self.node.check_statusword()
 

@@ -51,6 +51,7 @@ _PARAMETER_KEYS = frozenset(
         "derived",
         "index",
         "procedure",
+        "repeatable",
         "disabled",
     }
 )
@@ -130,6 +131,7 @@ class _ListReader:
             derived=section.get("Derived", "") or "",
             indices=indices,
             procedure=self._flag(section, "Procedure"),
+            repeatable=self._repeatable(section),
             disabled_only=self._flag(section, "Disabled"),
             enum=self._enum(section, data_type),
             bits=self._bits(section, data_type),
@@ -163,6 +165,13 @@ class _ListReader:
             return Persistence(text.upper())
         except ValueError:
             raise self.error(section, "Save", f"Save {text!r} is not one of E, S, RAM") from None
+
+    def _repeatable(self, section: IniSection) -> bool:
+        """Only a procedure can be run again: a value write is repeated after a lost exchange anyway."""
+        repeatable = self._flag(section, "Repeatable")
+        if repeatable and not self._flag(section, "Procedure"):
+            raise self.error(section, "Repeatable", "Repeatable=yes needs Procedure=yes")
+        return repeatable
 
     def _flag(self, section: IniSection, key: str) -> bool:
         text = (section.get(key, "no") or "no").lower()

@@ -60,6 +60,9 @@ class Parameter:
     derived: str = ""
     indices: range | None = None
     procedure: bool = False
+    repeatable: bool = False
+    """A procedure whose second run leaves the drive as one run does (a copy, a save): sent again when its station
+    comes back into data exchange, as a read or a value write is (`drive/profibus/engine.py`)."""
     disabled_only: bool = False
     enum: Mapping[int, str] = field(default_factory=dict)
     bits: tuple[BitField, ...] = ()

@@ -1,11 +1,15 @@
 """The PKW engine (docs/profibus.md §9): a `Drive` on the TTA-PRO parameter list reads and writes PNUs of the
 simulated slave over its TCP stream exactly as it does CANopen objects — width and sign from the list, IND as the
 subindex, a procedure waited for, a negative reply as a readable error naming the PNU, a value out of range refused
-before anything is sent, and what only CANopen does refused."""
+before anything is sent, what only CANopen does refused, and a procedure cut by a lost exchange run again only when
+the parameter list says it may be."""
 
 from __future__ import annotations
 
+import dataclasses
+import threading
 from collections.abc import Iterator
+from contextlib import contextmanager
 
 import pytest
 from tests.support.profibus_line import TtaProLine, ttapro_line
@@ -15,8 +19,9 @@ from servostudio.drive.profibus.engine import PkwEngine, PkwRefusal, StationOutO
 from servostudio.drive.profibus.link import NoCanFrames, ProfibusLink
 from servostudio.drive.profiles import profile_for
 from servostudio.drive.sdo import SdoAbortError
-from servostudio.errors import ErrorKind
+from servostudio.errors import ErrorKind, ServoStudioError
 from servostudio.od.pnu import builtin_parameter_list
+from servostudio.od.pnu_model import ParameterDictionary
 from servostudio.transport.profibus.master import ByteLink, DpMaster
 
 ADDRESS = 5
@@ -99,3 +104,59 @@ def test_a_node_no_dp_slave_can_have_is_refused_before_sending(engine: PkwEngine
     drive = Drive(engine, 126, builtin_parameter_list(), profile_for("ttapro"))
     with pytest.raises(StationOutOfRange, match=r"^DP station address 126 outside 1\.\.125: nothing was sent$"):
         drive.read("PNU700")
+
+
+# -- a station that leaves data exchange while a procedure runs ------------------------------------------------
+
+
+def _drop_while_the_first_procedure_runs(line: TtaProLine) -> list[int]:
+    """Make the slave leave data exchange (its DP watchdog expired) 30 ms after it starts its first procedure; the
+    PNUs of the procedures it starts, in order."""
+    slave = line.slaves[ADDRESS]
+    started: list[int] = []
+    start = slave.procedures.start
+
+    def drop() -> None:
+        with line.line.lock:
+            slave.station._leave_data_exchange()
+
+    def counting_start(pnu: int, value: int) -> None:
+        start(pnu, value)
+        started.append(pnu)
+        if len(started) == 1:
+            threading.Timer(0.03, drop).start()
+
+    slave.procedures.start = counting_start  # type: ignore[method-assign]
+    return started
+
+
+@contextmanager
+def _drive_on(line: TtaProLine, parameters: ParameterDictionary) -> Iterator[Drive]:
+    link = ProfibusLink("pb", DpMaster(ByteLink(line.spec.replace("profibus:tcp:", "socket://"))))
+    link.start()
+    try:
+        yield Drive(PkwEngine(link, lambda node: parameters), ADDRESS, parameters, profile_for("ttapro"))
+    finally:
+        link.close()
+
+
+def test_a_save_cut_by_a_lost_exchange_is_run_again_once_the_station_is_back() -> None:
+    """729 is `Repeatable` in the list: saving twice leaves the EEPROM as saving once."""
+    with ttapro_line(ADDRESS) as line, _drive_on(line, builtin_parameter_list()) as drive:
+        started = _drop_while_the_first_procedure_runs(line)
+        drive.write("max_motor_speed", 3100)
+        drive.start_procedure("save")
+        assert started == [729, 729]
+        line.slaves[ADDRESS].power_cycle()
+        assert drive.read("max_motor_speed").raw == 3100
+
+
+def test_a_procedure_not_marked_repeatable_is_never_run_twice() -> None:
+    """The same save, from a list that does not call it repeatable (as auto-phasing is not: it moves the motor)."""
+    parameters = builtin_parameter_list()
+    parameters.parameters[729] = dataclasses.replace(parameters.parameters[729], repeatable=False)
+    with ttapro_line(ADDRESS) as line, _drive_on(line, parameters) as drive:
+        started = _drop_while_the_first_procedure_runs(line)
+        with pytest.raises(ServoStudioError, match=r"PNU 729: DP station 5 refused Data_Exchange") as lost:
+            drive.start_procedure("save")
+        assert lost.value.kind is ErrorKind.UNAVAILABLE and started == [729]

@@ -235,8 +235,8 @@ class PkwEngine(SdoEngine):
             value = reply_value(request, reply, double=width.double, signed=width.signed)
             return value.to_bytes(width.size, "little", signed=width.signed)
         value = int.from_bytes(transfer.data, "little", signed=width.signed)
-        if width.procedure:  # never repeated: a procedure runs once per request
-            client.run_procedure(transfer.pnu, value, max(transfer.timeout, PROCEDURE_TIMEOUT))
+        if width.procedure:
+            _run_procedure(client, transfer.pnu, value, max(transfer.timeout, PROCEDURE_TIMEOUT), width.repeatable)
             return None
         request = write_request(transfer.pnu, value, width.double, transfer.index)
         reply = _through_recovery(lambda: client.transaction(request, timeout=transfer.timeout), transfer.timeout)
@@ -315,6 +315,16 @@ def _named(transfer: _Transfer, error: Exception) -> str:
     return text if text.startswith(("PNU ", "PZD")) else f"PNU {transfer.pnu}: {text}"
 
 
+def _run_procedure(client: TtaProClient, pnu: int, value: int, timeout: float, repeatable: bool) -> None:
+    """A procedure the parameter list calls repeatable (a copy, a save) is run again after a lost exchange like a
+    value write; any other (auto-phasing, auto-tuning: they move the motor) runs once per request, whatever happens."""
+    run = functools.partial(client.run_procedure, pnu, value, timeout)
+    if repeatable:
+        _through_recovery(run, timeout)
+    else:
+        run()
+
+
 def _through_recovery(transaction: Callable[[], T], patience: float) -> T:
     """A read or a value write whose station left data exchange meanwhile is sent again once the cyclic exchange
     has parameterised it again (within ``patience`` seconds of the loss): the request is idempotent (a read, or the
@@ -336,6 +346,7 @@ class _Width:
     double: bool
     signed: bool
     procedure: bool = False
+    repeatable: bool = False
 
     @property
     def size(self) -> int:
@@ -347,7 +358,7 @@ class _Width:
         if parameter is None:
             return cls(double=data is not None and len(data) > 2, signed=False)
         signed = parameter.data_type in (DataType.INTEGER16, DataType.INTEGER32)
-        return cls(parameter.is_double, signed, parameter.procedure)
+        return cls(parameter.is_double, signed, parameter.procedure, parameter.repeatable)
 
 
 class _NodeWorker:
