@@ -8,11 +8,11 @@ import contextlib
 import csv
 import io
 import json
-import time
 from collections.abc import Iterator
 
 import pytest
 from tests.support.access import admin_app, api_client
+from tests.support.waits import eventually
 
 from servostudio.api.app import Settings
 from servostudio.services.users import Level
@@ -104,7 +104,7 @@ def test_an_expert_takes_over_explicitly_and_lower_levels_may_not(client, app):
             assert velocity.status_code == 409  # A is no longer the controller
             assert expert.put(f"{NODE}/objects/target_velocity", json={"value": 0}, headers=e).status_code == 200
         # the expert's socket closed: the axis it held stopped
-        assert _eventually(client, lambda: state(client) != "OPERATION ENABLED")
+        eventually(lambda: state(client) != "OPERATION ENABLED", 10.0)
     taken_over = client.get("/api/audit", params={"axis": "sim:1", "action": "take_over"}).json()["entries"][0]
     assert taken_over["client"] == e["X-Servo-Client"] and a["X-Servo-Client"] in taken_over["detail"]
 
@@ -113,8 +113,8 @@ def test_the_holder_s_loss_quick_stops_the_axis_and_is_logged(client):
     with live(client) as (_, a):
         client.post(f"{NODE}/control/arm", headers=a)
         assert client.put(f"{NODE}/state", json={"target": "operation-enabled"}, headers=a).status_code == 200
-    assert _eventually(client, lambda: state(client) in ("QUICK STOP ACTIVE", "SWITCH ON DISABLED"))
-    assert _eventually(client, lambda: _actions(client)[:1] == ["quick_stop"])
+    eventually(lambda: state(client) in ("QUICK STOP ACTIVE", "SWITCH ON DISABLED"), 10.0)
+    eventually(lambda: _actions(client)[:1] == ["quick_stop"], 10.0)
     stop = client.get("/api/audit", params={"action": "quick_stop", "limit": 1}).json()["entries"][0]
     assert stop["user"] == "server" and a["X-Servo-Client"] in stop["detail"] and stop["result"] == "ok"
     assert {"arm", "enable"} <= set(_actions(client))
@@ -155,12 +155,3 @@ def test_every_write_is_in_the_audit_log_with_old_and_new_values(client):
 
 def _actions(client) -> list[str]:
     return [entry["action"] for entry in client.get("/api/audit", params={"axis": "sim:1"}).json()["entries"]]
-
-
-def _eventually(client, condition, timeout: float = 10.0) -> bool:
-    deadline = time.monotonic() + timeout
-    while not condition():
-        if time.monotonic() > deadline:
-            return False
-        time.sleep(0.05)
-    return True

@@ -12,8 +12,9 @@ import time
 
 import pytest
 from tests.support.dp_masters import OWN_MASTER, PYPROFIBUS
-from tests.support.jobs_api import armed, eventually, holding
+from tests.support.jobs_api import armed, holding
 from tests.support.profibus_line import TtaProLine, tool_on_line, ttapro_line
+from tests.support.waits import eventually
 
 from servostudio.sim.drive.statemachine import State
 from servostudio.sim.profibus.endpoints import ProfibusPty

@@ -12,8 +12,9 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 
 import pytest
-from tests.support.jobs_api import armed, eventually, holding
+from tests.support.jobs_api import armed, holding
 from tests.support.profibus_line import tool_on_line, ttapro_line
+from tests.support.waits import eventually
 
 from servostudio.sim.drive.statemachine import State
 from servostudio.sim.profibus.faults import FOLLOWING_ERROR

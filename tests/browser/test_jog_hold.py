@@ -19,7 +19,8 @@ import pytest
 from playwright.sync_api import Browser, Page, expect
 from tests.support.browser import CHROMIUM_ARGS
 from tests.support.live_server import REPO_ROOT, free_port
-from tests.support.motion_timing import DriveProbe, InProcessServer, KeepaliveLog, wait_until
+from tests.support.motion_timing import DriveProbe, InProcessServer, KeepaliveLog
+from tests.support.waits import eventually
 
 BUDGET = 0.2  # seconds from the last keepalive to the stop (issue #13)
 
@@ -66,7 +67,7 @@ def hold_until_enabled(page: Page, server: InProcessServer, testid: str, node: i
     for _attempt in range(2):
         before = _motion_id(server, node)
         hold(page, testid)
-        wait_until(_enabled_or_watchdog_ended(server, node, before), 10, "the jog")
+        eventually(_enabled_or_watchdog_ended(server, node, before), 10, "the jog")
         if state(server, node) == "OPERATION ENABLED":
             return
         page.mouse.up()
@@ -134,7 +135,7 @@ def _chromium(tmp_path) -> tuple[subprocess.Popen, int]:
     process = subprocess.Popen(
         [*command, *CHROMIUM_ARGS, "about:blank"], start_new_session=True, stderr=subprocess.DEVNULL
     )
-    wait_until(lambda: _answers(port), 30, "chromium's DevTools endpoint")
+    eventually(lambda: _answers(port), 30, "chromium's DevTools endpoint")
     return process, port
 
 
@@ -151,7 +152,7 @@ def _hold_until_running(page: Page, server: InProcessServer, keepalives: Keepali
     for _attempt in range(3):
         hold(page, "jog-plus")
         with contextlib.suppress(AssertionError):
-            wait_until(lambda: len(keepalives.times) > 10 and probe.was_running(), 10, "the held jog")
+            eventually(lambda: len(keepalives.times) > 10 and probe.was_running(), 10, "the held jog")
             if api(server, "GET", "/3/motion")["state"] == "running":
                 return
         page.mouse.up()
@@ -173,8 +174,8 @@ def test_a_browser_killed_mid_jog_stops_the_axis_within_200_ms_of_its_last_keepa
         probe = DriveProbe(server.network, 3)
         _hold_until_running(page, server, keepalives, probe)
         os.killpg(process.pid, signal.SIGKILL)  # the whole browser, at once
-        wait_until(lambda: state(server, 3) != "OPERATION ENABLED", 5, "the stop")
-        wait_until(lambda: probe.samples[-1].time > probe.stop_began() + 0.05, 5, "the samples after the stop")
+        eventually(lambda: state(server, 3) != "OPERATION ENABLED", 5, "the stop")
+        eventually(lambda: probe.samples[-1].time > probe.stop_began() + 0.05, 5, "the samples after the stop")
         probe.stop()
     finally:
         with contextlib.suppress(ProcessLookupError):

@@ -12,6 +12,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from canopen.profiles.p402 import BaseNode402, State402
+from tests.support.waits import wait_for
 
 from servostudio.od.library import BUILTIN_EDS_DIR
 
@@ -94,38 +95,24 @@ class Axis:
 
     def wait_status(self, condition: Callable[[int], bool], what: str, timeout: float = WAIT) -> int:
         """Wait until the last received status word satisfies `condition`; fail naming `what` otherwise."""
-        return self._wait_for(
+        return wait_for(
             lambda: self.status,
             condition,
-            what,
+            f"node {self.node.id}: {what}",
             timeout,
-            0.005,
-            lambda status: f"last status word 0x{status:04X} ({state_of(status)})",
+            describe=lambda status: f"last status word 0x{status:04X} ({state_of(status)})",
         )
 
     def wait_value(self, index: int, condition: Callable[[int], bool], what: str, timeout: float = WAIT) -> int:
         """Poll an object by SDO until `condition` holds; fail naming `what` and the last value otherwise."""
-        return self._wait_for(
-            lambda: self.read(index), condition, what, timeout, 0.01, lambda value: f"0x{index:04X} = {value}"
+        return wait_for(
+            lambda: self.read(index),
+            condition,
+            f"node {self.node.id}: {what}",
+            timeout,
+            0.01,
+            lambda value: f"0x{index:04X} = {value}",
         )
-
-    def _wait_for(
-        self,
-        sample: Callable[[], int],
-        condition: Callable[[int], bool],
-        what: str,
-        timeout: float,
-        period: float,
-        last: Callable[[int], str],
-    ) -> int:
-        deadline = time.monotonic() + timeout
-        while True:
-            value = sample()
-            if condition(value):
-                return value
-            if time.monotonic() > deadline:
-                raise AssertionError(f"node {self.node.id}: {what} not seen within {timeout} s; {last(value)}")
-            time.sleep(period)
 
     def wait_state(self, state: str, timeout: float = WAIT) -> int:
         return self.wait_status(lambda status: state_of(status) == state, f"state {state}", timeout)

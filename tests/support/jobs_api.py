@@ -7,7 +7,7 @@ from __future__ import annotations
 import contextlib
 import threading
 import time
-from collections.abc import Callable, Iterator
+from collections.abc import Iterator
 
 NODE = "/api/buses/sim/nodes/1"
 
@@ -46,15 +46,6 @@ def holding(socket, bus: str, node: int) -> Iterator[None]:
     finally:
         stop.set()
         sender.join()
-
-
-def eventually(condition: Callable[[], bool], timeout: float = 2.0) -> float:
-    """Seconds until ``condition`` held (fails after ``timeout``)."""
-    start = time.monotonic()
-    while not condition():
-        assert time.monotonic() - start < timeout, "the condition never held"
-        time.sleep(0.005)
-    return time.monotonic() - start
 
 
 def finished(client, job: str, timeout: float = 60.0) -> dict:

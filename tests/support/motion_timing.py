@@ -162,11 +162,3 @@ class DriveProbe:
             if sample.time >= began and abs(sample.speed) < STANDSTILL:
                 return sample.time
         raise AssertionError("the axis never came to standstill")
-
-
-def wait_until(condition, timeout: float, what: str) -> None:
-    deadline = time.monotonic() + timeout
-    while not condition():
-        if time.monotonic() > deadline:
-            raise AssertionError(f"{what} did not happen within {timeout} s")
-        time.sleep(0.01)

@@ -12,12 +12,12 @@ from __future__ import annotations
 
 import struct
 import threading
-import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
 import canopen
+from tests.support.waits import wait_for
 
 from servostudio.od.library import BUILTIN_EDS_DIR
 from servostudio.sim.drive import make_behaviour
@@ -152,7 +152,7 @@ class Bench:
     def procedure(self, index: int, code: int) -> int:
         """Write a signature to `index`,1 and wait for its status to leave "running" (decisions.md §4)."""
         self.write(index, code, 1)
-        return self.wait(lambda: self.read(index, 1), lambda status: status != 2, f"0x{index:04X},1 finished")
+        return wait_for(lambda: self.read(index, 1), lambda status: status != 2, f"0x{index:04X},1 finished")
 
     # -- motion ---------------------------------------------------------------------------------------------------
 
@@ -160,7 +160,7 @@ class Bench:
         self.write(0x6060, SEQUENCE_MODE)
         for control_word in (0x06, 0x07, CW_ENABLE_OPERATION):
             self.write(0x6040, control_word)
-        self.wait(lambda: self.read(0x6041), lambda status: status & 0x6F == 0x27, "Operation Enabled")
+        wait_for(lambda: self.read(0x6041), lambda status: status & 0x6F == 0x27, "Operation Enabled")
 
     def start(self, number: int) -> int:
         """0x3601,1 = number, then a rising edge of control word bit 4; the mark to read changes from."""
@@ -180,13 +180,13 @@ class Bench:
             numbers = [row[EXECUTED] for row in self.rows(mark)]
             return any(number >= 0 for number in numbers) and numbers[-1] == -1
 
-        self.wait(lambda: int(ended()), bool, "the end of the program", timeout)
+        wait_for(lambda: int(ended()), bool, "the end of the program", timeout)
         return self.rows(mark)
 
     def run_for(self, seconds: float) -> None:
         """Let the drive run `seconds` of virtual time (a loaded host makes that longer in wall-clock time)."""
         until = self.network.now + seconds
-        self.wait(lambda: int(self.network.now >= until), bool, f"{seconds} s of virtual time")
+        wait_for(lambda: int(self.network.now >= until), bool, f"{seconds} s of virtual time")
 
     # -- observation ----------------------------------------------------------------------------------------------
 
@@ -205,17 +205,6 @@ class Bench:
         with self._lock:
             numbers = [change.number for change in self.changes if change.time > since]
         return [number for n, number in enumerate(numbers) if n == 0 or numbers[n - 1] != number]
-
-    @staticmethod
-    def wait(sample: Callable[[], int], condition: Callable[[int], bool], what: str, timeout: float = WAIT) -> int:
-        deadline = time.monotonic() + timeout
-        while True:
-            value = sample()
-            if condition(value):
-                return value
-            if time.monotonic() > deadline:
-                raise AssertionError(f"{what} not seen within {timeout} s (last value {value})")
-            time.sleep(0.01)
 
 
 def first(rows: Sequence[Row], condition: Callable[[Row], bool], what: str) -> Row:

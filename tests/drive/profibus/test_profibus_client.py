@@ -5,11 +5,11 @@ line."""
 
 from __future__ import annotations
 
-import time
-from collections.abc import Callable, Iterator
+from collections.abc import Iterator
 
 import pytest
 from tests.support.dp_masters import TRANSPORTS, dp_master, simulated_line
+from tests.support.waits import eventually
 
 from servostudio.drive.profibus.client import PkwTimeout, ProfibusLinkDown, TtaProClient
 from servostudio.drive.profibus.pkw import read_request
@@ -35,13 +35,6 @@ def client(request: pytest.FixtureRequest, line: ProfibusLine) -> Iterator[TtaPr
         client = TtaProClient(master, ADDRESS).start()
         yield client
         client.close()
-
-
-def _eventually(condition: Callable[[], bool], seconds: float = 2.0) -> None:
-    deadline = time.monotonic() + seconds
-    while not condition():
-        assert time.monotonic() < deadline, "condition not met in time"
-        time.sleep(0.005)
 
 
 def test_pnus_read_and_write_with_their_width_and_sign(client: TtaProClient) -> None:
@@ -92,7 +85,7 @@ def test_the_control_word_walks_the_state_machine(client: TtaProClient) -> None:
 
 def _command(client: TtaProClient, control_word: int, state: DriveState) -> None:
     client.set_output(0, control_word)
-    _eventually(lambda: drive_state(client.status_word) is state)
+    eventually(lambda: drive_state(client.status_word) is state)
 
 
 def test_a_silent_slave_is_reported_and_recovered(client: TtaProClient, line: ProfibusLine) -> None:
@@ -100,12 +93,12 @@ def test_a_silent_slave_is_reported_and_recovered(client: TtaProClient, line: Pr
     client.exchange.master.timeout = 0.02
     with line.lock:
         slave = line.slaves.pop(ADDRESS)  # the station stops answering (cable pulled)
-    _eventually(lambda: client.exchange.error is not None)
+    eventually(lambda: client.exchange.error is not None)
     with pytest.raises(ProfibusLinkDown, match="PNU 700: DP station 5 did not answer"):
         client.read(700, double=False, signed=False)
     with line.lock:
         line.slaves[ADDRESS] = slave
-    _eventually(lambda: client.exchange.error is None)
+    eventually(lambda: client.exchange.error is None)
     assert client.read(700, double=False, signed=False) == 4
 
 
@@ -117,10 +110,10 @@ def test_a_cut_tcp_line_is_reported_and_reopened(line: ProfibusLine) -> None:
     try:
         assert client.read(700, double=False, signed=False) == 4
         server.stop()  # the line is cut: the connection closes
-        _eventually(lambda: client.exchange.error is not None)
+        eventually(lambda: client.exchange.error is not None)
         assert "PROFIBUS line" in str(client.exchange.error) or "did not answer" in str(client.exchange.error)
         server = ProfibusTcpServer(line, host, port).start()  # and comes back on the same port
-        _eventually(lambda: client.exchange.error is None, seconds=5.0)
+        eventually(lambda: client.exchange.error is None, timeout=5.0)
         assert client.read(700, double=False, signed=False) == 4
     finally:
         client.close()

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import pytest
 from tests.support.sequencer_bench import EXECUTED, REV, Bench
+from tests.support.waits import wait_for
 
 MOVE = f"""SeqType=POS
 PosType=REL
@@ -61,7 +62,7 @@ def run_program(bench: Bench, program: str, first: int = 1) -> list[int]:
     since = bench.network.now
     rows = bench.wait_program_end(bench.start(first))
     probed = collapsed([row[EXECUTED] for row in rows])
-    bench.wait(lambda: bench.executed(since)[-1:] == [-1], bool, "TPDO 2 reporting the end")
+    wait_for(lambda: bench.executed(since)[-1:] == [-1], bool, "TPDO 2 reporting the end")
     reported = bench.executed(since)
     assert reported == probed[probed.index(first) :]
     return reported

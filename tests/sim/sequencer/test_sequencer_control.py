@@ -20,6 +20,7 @@ from tests.support.sequencer_bench import (
     Bench,
     first,
 )
+from tests.support.waits import wait_for
 
 SEQ = 1 << 1  # dedicated output bit 1
 IN1_TO_CONDITION_BIT_0 = 0x36010300  # 0x3050,1: IN1 -> 0x3601,3 bit 0
@@ -51,7 +52,7 @@ def test_bit_5_stops_the_program_without_its_end_and_without_chaining(bench: Ben
     assert rows[-1][PHASE] == BEGIN | CRUISE | DECEL | HOLD  # braked to standstill, no END
     bench.run_for(0.1)  # 0x606C is filtered (80 Hz): it lags the standstill
     assert bench.read(0x606C) == pytest.approx(0, abs=0.02 * 5 * REV)
-    status = bench.wait(lambda: bench.read(0x6041), lambda status: status & 0x400, "target reached (SW10)")
+    status = wait_for(lambda: bench.read(0x6041), lambda status: status & 0x400, "target reached (SW10)")
     assert not status & 0x2000  # SW13: no sequence running
 
 

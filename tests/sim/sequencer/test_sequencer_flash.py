@@ -5,6 +5,7 @@ file does not declare, and a file the drive cannot take is error 44 (EMCY 0x6320
 from __future__ import annotations
 
 from tests.support.sequencer_bench import REV, Bench
+from tests.support.waits import wait_for
 
 from servostudio.formats.sequence_model import BitPattern, Sequence
 from servostudio.formats.sequence_spec import SequenceType
@@ -44,7 +45,7 @@ def write_program(bench: Bench, program: dict[int, Sequence]) -> dict[int, dict[
 def warm_reset(bench: Bench) -> None:
     bench.write(0x205D, WARM_RESET)
     bench.node.nmt.state = "RESET"
-    bench.wait(lambda: bench.network.node(1).state.value == "PRE-OPERATIONAL", bool, "the node booted")
+    wait_for(lambda: bench.network.node(1).state.value == "PRE-OPERATIONAL", bool, "the node booted")
 
 
 def test_sseq_warm_reset_and_lseq_give_the_sequence_memory_back_exactly(bench: Bench):
@@ -94,7 +95,7 @@ def test_a_bad_sequence_file_is_error_44_and_changes_neither_memory_nor_file(ben
 
 
 def assert_error_44(bench: Bench) -> None:
-    emcy = bench.wait(lambda: len(bench.node.emcy.log), bool, "an EMCY")
+    emcy = wait_for(lambda: len(bench.node.emcy.log), bool, "an EMCY")
     assert emcy == 1
     error = bench.node.emcy.log[0]
     assert error.code == 0x6320 and error.data[0] == 44  # byte 3 of the frame: the Infranor error code

@@ -6,6 +6,7 @@ from __future__ import annotations
 import canopen
 import pytest
 from tests.support.sequencer_bench import EXECUTED, SIM_PHYSICAL_INPUTS, Bench
+from tests.support.waits import wait_for
 
 from servostudio.od import builtin_library
 
@@ -48,7 +49,7 @@ def test_the_wiring_survives_a_warm_reset(bench: Bench):
     bench.set_physical_inputs(0b01100)
     bench.write(0x205D, 2)
     bench.node.nmt.state = "RESET"
-    bench.wait(lambda: bench.network.node(1).state.value == "PRE-OPERATIONAL", bool, "the node booted")
+    wait_for(lambda: bench.network.node(1).state.value == "PRE-OPERATIONAL", bool, "the node booted")
     assert bench.read(0x3058, 3) == 0b01100 and bench.read(0x60FD) >> 16 & 0x1F == 0b01100
 
 
