@@ -134,15 +134,30 @@ class FlashFiles:
             entries = parse_object_file(text, name, self._problem)
         except ObjectFileError as exc:
             return self._failed(name, str(exc))
+        applied: list[tuple[ObjectEntry, Value]] = []
         for entry in entries:
             if only is not None and entry.index not in only:
                 continue
-            var = self.store.od[(entry.index, entry.sub)]
             try:
-                self.store.write_value(var, _object_value(var, entry.value))
+                applied.append((entry, self._apply(entry)))
             except SdoAbort as exc:
                 return self._failed(name, f"{name}:{entry.line}: {exc}")
+        self._undo_copies(applied)
         return True
+
+    def _apply(self, entry: ObjectEntry) -> Value:
+        """Write one entry as a bus write would (range checks, hooks); the value the store then holds."""
+        var = self.store.od[(entry.index, entry.sub)]
+        self.store.write_value(var, _object_value(var, entry.value))
+        return self.store.get(entry.index, entry.sub)
+
+    def _undo_copies(self, applied: list[tuple[ObjectEntry, Value]]) -> None:
+        """Give back the file's value to every entry a later entry's write hook changed: a drive restores its saved
+        image as saved. The copy rules model a user's write (XtrapulsPac motor data 0x6410,14-16 → the commutation
+        0x3410, which `apha` may have set otherwise since), not the power-up."""
+        for entry, value in applied:
+            if self.store.get(entry.index, entry.sub) != value:
+                self._apply(entry)
 
     def save_sequences(self) -> bool:
         """sseq: sequence memory -> SEQUENCE.TXT; error 44 when a slot cannot be written as a file."""

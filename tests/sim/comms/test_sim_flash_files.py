@@ -9,6 +9,7 @@ from tests.support.sim_test_drive import frames_with_id, write
 
 from servostudio.formats.objectfile import read_object_file
 from servostudio.sim.flash import LOAD, LOAD_USER, SAVE, signature
+from servostudio.sim.network import SimulatedNetwork
 
 
 def test_signatures_are_little_endian_ascii():
@@ -115,3 +116,42 @@ def test_bad_drivepar_at_power_on_raises_error_42_once_booted(make_network, tmp_
     assert network.node(1).behaviour.errors == [42]
     assert network.node(1).store.get(0x6083) == 65536  # nothing of the file applied
     assert "0x7777,0 is not in the testdrive dictionary" in network.node(1).flash.last_error
+
+
+PHASING = {1: 6, 2: 21845, 3: 49429}
+"""0x3410,1-3 (pole pairs, phase order, sensor offset) as `apha` leaves them, unlike the catalogue's motor data."""
+
+
+def _phased_and_saved(client) -> None:
+    """Motor data from a catalogue (0x6410,14-16, copied into 0x3410 when written), then a phasing that found other
+    commutation values, then a save: the file holds both, 0x3410 before 0x6410."""
+    for sub, value in ((14, 4), (15, 21845), (16, 0)):
+        write(client, 1, 0x6410, sub, value, size=2)
+    for sub, value in PHASING.items():
+        write(client, 1, 0x3410, sub, value, size=2)
+    write(client, 1, 0x1010, 1, SAVE)
+    client.collect(0.3)
+
+
+def test_a_saved_phasing_survives_a_load_a_warm_reset_and_a_power_on(raw_client, tmp_path):
+    """The XtrapulsPac's copy rule 0x6410 → 0x3410 is a user's write of motor data; restoring the saved image is not
+    one: what `apha` found and the user saved is what the drive commutates with after a LOAD, a warm reset and a
+    power-on."""
+    client = raw_client(_xtrapulspac(tmp_path))
+    client.collect(0.001)
+    _phased_and_saved(client)
+    assert {sub: drivepar(tmp_path)[0x3410, sub] for sub in PHASING} == PHASING
+    store = client.network.node(1).store
+    write(client, 1, 0x1011, 1, LOAD)
+    assert {sub: store.get(0x3410, sub) for sub in PHASING} == PHASING
+    write(client, 1, 0x205D, 0, 2, size=2)
+    client.send(0x000, bytes([0x81, 1]))
+    client.collect(0.01)
+    assert {sub: client.network.node(1).store.get(0x3410, sub) for sub in PHASING} == PHASING
+    powered_on = _xtrapulspac(tmp_path).node(1).store
+    assert {sub: powered_on.get(0x3410, sub) for sub in PHASING} == PHASING
+    assert powered_on.get(0x6410, 14) == 4  # the motor data stays the catalogue's
+
+
+def _xtrapulspac(state_dir) -> SimulatedNetwork:
+    return SimulatedNetwork("1", device="xtrapulspac", state_dir=state_dir)
