@@ -2,7 +2,8 @@
 excitation (docs/frequency-response.md §8), on simulated CD1-ks commissioned for HIDDEN seeded plants and judged
 against the plants' true values: the latency of a value from its SYNC to the response, the plant on awkward plants,
 the closed loop's bandwidth against a step on the simulator, the bus budget, and the abort at the position window
-with everything the run borrowed written back.
+with everything the run borrowed written back; and the free-running encoTRive (no 0x1006), whose response is
+placed in time, on the bench in real time.
 
 Then the source's estimator pieces on signals whose answer is known exactly (no drive): the current monitor's
 timing, the held staircase's line, the latency found from the read-back.
@@ -34,6 +35,7 @@ from servostudio.services.cancel import Cancellation, Cancelled
 from servostudio.services.frequency import estimate
 from servostudio.services.frequency.measure import MODE_PV, SYNC_PERIOD_S, MeasureRequest, check_request
 from servostudio.services.frequency.stream import ExcitationStream
+from servostudio.services.frequency.timed import WINDOWS
 from servostudio.services.frequency.tpdo_source import (
     BusTooSlow,
     NotApplied,
@@ -43,7 +45,6 @@ from servostudio.services.frequency.tpdo_source import (
     plan_response,
 )
 from servostudio.services.procedures.run import disable
-from servostudio.services.scope import NoRecorder
 from servostudio.sim.plant import Plant
 
 CD1K_PER_REV = 65536
@@ -213,14 +214,32 @@ def test_the_latency_is_found_from_the_read_back_and_a_read_back_not_the_excitat
         latency([float(sent(100 + k // 2)) for k in range(200)], sent, 100)  # values a SYNC late half the time
 
 
-def test_a_drive_whose_cycle_does_not_follow_the_sync_is_refused_before_anything_is_written(frequency_bench):
-    """The encoTRive has neither a recorder nor 0x1006: its TPDO answers come at instants its own clock picks, and a
-    Bode through them is tens of dB and degrees off the hidden plant (docs/frequency-response.md §8). Refused, not
-    measured wrong."""
-    bench = frequency_bench(Plant.from_seed(5), device="encotrive")
+def _errors(result: dict, plant: Plant, up_to_hz: float) -> tuple[float, float]:
+    """The largest |dB| and |°| of the measured plant against its true 1/(J·s + B) up to ``up_to_hz``."""
+    errors = [plant_error(point, plant) for point in result["points"] if point["freq_hz"] <= up_to_hz]
+    return max(abs(db) for db, _ in errors), max(abs(deg) for _, deg in errors)
+
+
+def test_the_free_running_encotrive_s_plant_is_measured_in_time(frequency_bench):
+    """The encoTRive has neither a recorder nor 0x1006: it takes each SYNC when it comes. Its excitation follows the
+    drive's time and its answers are placed at their own time stamps (docs/frequency-response.md §8), so the
+    hidden plant comes out within 1.5 dB and 10° to 100 Hz, 3 dB and 20° to 200 Hz, on the bench in real time."""
+    plant = Plant.from_seed(22)
+    bench = frequency_bench(plant, speed=1.0, device="encotrive")
     before = tuple(read_tpdo(bench.drive(), slot) for slot in tpdo_slots(bench.drive().dictionary))
-    for loop in ("plant", "closed"):
-        with pytest.raises(NoRecorder, match=r"no communication cycle period \(0x1006\)"):
-            bench.measure(loop=loop, amplitude_pct=80, base_speed_rad_s=15, periods=4, position_window=200)
+    result = bench.measure(loop="plant", amplitude_pct=80, base_speed_rad_s=15, to_hz=200, position_window=200)
+    assert result["aborted"] is None and result["excitation"]["source"] == "tpdo"
+    assert result["excitation"]["periods"] == WINDOWS
+    low, high = _errors(result, plant, 100.5), _errors(result, plant, 200.5)
+    assert low[0] < 1.5 and low[1] < 10.0, low
+    assert high[0] < 3.0 and high[1] < 20.0, high
     assert tuple(read_tpdo(bench.drive(), slot) for slot in tpdo_slots(bench.drive().dictionary)) == before
-    assert bench.drive().read("statusword").raw & 0x6F != 0x27  # never enabled
+
+
+def test_the_free_running_encotrive_s_closed_loop_bandwidth_agrees_with_a_step(frequency_bench):
+    plant = Plant.from_seed(5)
+    bench = frequency_bench(plant, speed=1.0, device="encotrive")
+    result = bench.measure(loop="closed", amplitude_pct=80, base_speed_rad_s=15, to_hz=300, position_window=200)
+    assert result["aborted"] is None
+    expected = step_bandwidth(plant, device="encotrive", per_rev=60)  # the encoTRive's speeds are in rpm
+    assert result["markers"]["bandwidth_hz"] == pytest.approx(expected, rel=0.10)

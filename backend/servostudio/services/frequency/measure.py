@@ -28,7 +28,7 @@ from servostudio.drive.link import BusLink
 from servostudio.drive.sync import CYCLE_PERIOD
 from servostudio.errors import InvalidInput, ServoStudioError
 from servostudio.services.cancel import Cancellation, Cancelled
-from servostudio.services.frequency import estimate, markers, tpdo_source
+from servostudio.services.frequency import estimate, markers, timed, tpdo_source
 from servostudio.services.frequency.excitation import Multisine, design
 from servostudio.services.frequency.speed_loop import NoSpeedLoop, read_speed_loop
 from servostudio.services.frequency.stream import ExcitationStream
@@ -137,20 +137,20 @@ def check_request(drive: Drive, request: MeasureRequest, bitrate: int | None = N
 
 
 def _follows_sync(drive: Drive) -> bool:
-    """A drive that can be told the SYNC period (0x1006) locks its control cycle to the SYNC (CiA 301)."""
+    """A drive that can be told the SYNC period (0x1006) locks its control cycle to the SYNC (CiA 301); one that
+    cannot free-runs, and its response is placed in time (``timed``)."""
     return drive.dictionary is not None and drive.dictionary.get(*CYCLE_PERIOD) is not None
+
+
+def _control_period_s(drive: Drive) -> float:
+    """The drive's control period (its speed-loop description's), the grid its answers' values come from."""
+    loop = drive.profile.speed_loop
+    return loop.control_period_s if loop is not None else RECORD_PERIOD_US * 1e-6
 
 
 def _response_plan(drive: Drive, request: MeasureRequest, bitrate: int | None) -> ResponsePlan:
     """The TPDO response's plan, or the refusal: a plant needs the current actual value, and the bus the SYNC
     rate's frames."""
-    if not _follows_sync(drive):
-        raise NoRecorder(
-            f"node {drive.node}: the {drive.profile.device} has no recorder and no communication cycle period "
-            "(0x1006): its control cycle does not follow the SYNC, so its TPDO answers are not samples at known "
-            "instants (the host's SYNC jitter, a fraction of a millisecond, is tens of degrees at 100 Hz); a "
-            "frequency response needs the drive's recorder or a drive that locks its cycle to the SYNC"
-        )
     current = _present(drive, "current_actual")
     if request.loop == "plant" and not current:
         raise NoRecorder(
@@ -315,6 +315,8 @@ def measure(
     try:
         _prepare(drive, request, saved, axis, source)
         values = _values(request, signal, axis, source, gains)
+        if response is not None and not _follows_sync(drive):
+            values = _values_in_time(request, signal, axis, gains, response)
         watch = Watch(drive, limits, quick_stop, controlled, cancellation, _watched(drive, response)).start()
         stream.open(operational)
         if response is not None:
@@ -350,8 +352,40 @@ def _collect(drive: Drive, request: MeasureRequest, signal: Multisine, axis: Axi
         captures = _record(drive, request, signal, watch, report)
         periods = sum(len(c.columns[0]) // _block(signal) for c in captures)
         return Collected("recorder", periods, lambda: _estimate(request, signal, axis, captures), in_torque)
+    if not _follows_sync(drive):
+        period_s = _control_period_s(drive)
+        answers = _follow_in_time(response, stream, signal, watch, report, period_s)
+        windows = timed.WINDOWS if answers is not None else 0
+        return Collected("tpdo", windows, lambda: _timed_estimate(request, signal, axis, answers, period_s),
+                         in_torque)  # fmt: skip
     blocks = _follow(response, stream, signal, request, watch, report)
     return Collected("tpdo", len(blocks), lambda: _tpdo_estimate(request, signal, axis, blocks, sent), in_torque)
+
+
+#: the answers of a free-running drive: the drive's control periods they were taken in, their columns, and the
+#: starts of the windows the estimate takes
+Answers = tuple[list[int], list[list[float]], list[float]]
+
+
+def _follow_in_time(response: ResponseStream, stream: ExcitationStream, signal: Multisine, watch: Watch,
+                    report: Report, period_s: float) -> Answers | None:  # fmt: skip
+    """A free-running drive's answers after settling, until they hold ``timed.WINDOWS`` windows without a stall
+    (counted in the drive's time) or ``timed.MORE_WINDOWS`` times the answers those take came; None when the watch
+    stopped the axis."""
+    start = math.ceil((SETTLE_S + signal.period_s) / SYNC_PERIOD_S)
+    count = math.ceil((timed.WINDOWS + 1) * signal.period_s / SYNC_PERIOD_S)
+    deadline = time.monotonic() + RESPONSE_STRETCH * (start + count) * SYNC_PERIOD_S + RESPONSE_MARGIN_S
+    most = round(timed.MORE_WINDOWS * count)
+    while True:
+        if not _answered(response, stream, start + count, watch, deadline):
+            return None
+        periods = timed.ticks(response.sync_instants(start, count), period_s)
+        instants = [n * period_s for n in periods]
+        starts = timed.clean_windows(instants, signal.period_s, timed.WINDOWS, count >= most)
+        if starts is not None:
+            report({"stage": "recording", "fraction": 0.9})
+            return periods, response.columns(start, count), starts
+        count += math.ceil(signal.period_s / SYNC_PERIOD_S)
 
 
 #: one period of the TPDO response: its first sample's number and the columns of its samples plus the next one
@@ -505,6 +539,16 @@ def _values(request: MeasureRequest, signal: Multisine, axis: Axis, source: str,
     base = axis.speed_user(request.base_speed_rad_s)
     swing = axis.speed_user(_swing(request, axis, gains))
     return lambda k: round(base + swing * signal.value(k))
+
+
+def _values_in_time(request: MeasureRequest, signal: Multisine, axis: Axis, gains: Mapping[str, Any] | None,
+                    response: ResponseStream) -> Callable[[int], int]:  # fmt: skip
+    """The value sent before each SYNC of a free-running drive: the excitation at the drive's present instant (its
+    answers' clock), so the excitation is periodic in the drive's time, not in the SYNCs' count."""
+    base = axis.speed_user(request.base_speed_rad_s)
+    swing = axis.speed_user(_swing(request, axis, gains))
+    excitation = timed.Excitation(signal)
+    return timed.values_in_time(excitation, response.clock.now, SYNC_PERIOD_S, lambda x: round(base + swing * x))
 
 
 def _swing(request: MeasureRequest, axis: Axis, gains: Mapping[str, Any] | None) -> float:
@@ -704,3 +748,19 @@ def _tpdo_estimate(request: MeasureRequest, signal: Multisine, axis: Axis, block
     if request.loop == "closed":
         return estimate.h1(targets, outputs, frequencies)
     return estimate.by_reference(targets, currents, outputs, frequencies)
+
+
+def _timed_estimate(request: MeasureRequest, signal: Multisine, axis: Axis, answers: Answers | None,
+                    period_s: float) -> list[estimate.Point]:  # fmt: skip
+    """A free-running drive's response placed in time (``timed``): each answer at the control period it was taken
+    in, the current on its 1-ms monitor's own grid."""
+    assert answers is not None
+    periods, columns, starts = answers
+    current = None
+    if request.loop == "plant":
+        torque = (axis.torque_constant or 1.0) * axis.rated_a / 1000.0
+        current = timed.monitored(periods, [torque * value for value in columns[2]], CURRENT_HOLD, period_s,
+                                  CURRENT_LATENCY_S)  # fmt: skip
+    response = timed.Timed([n * period_s for n in periods], [axis.rad(value) for value in columns[0]],
+                           [axis.speed_rad(value) for value in columns[1]], current)  # fmt: skip
+    return timed.estimate_timed(request.loop, response, signal, starts)

@@ -35,6 +35,7 @@ from servostudio.drive.tpdo import PDO_BYTES
 from servostudio.errors import CommunicationError
 from servostudio.od.model import Variable
 from servostudio.services.frequency import estimate
+from servostudio.services.frequency.timed import DriveClock
 from servostudio.services.scope.definition import CaptureDefinition
 from servostudio.services.scope.plan import CaptureRefused
 from servostudio.services.scope.stream import TpdoStream, _Receiver
@@ -96,13 +97,21 @@ def plan_response(drive: Drive, excited: Variable, bitrate: int | None, period_s
 
 @dataclass
 class _Timed(_Receiver):
-    """A TPDO's frames and when each arrived here."""
+    """A TPDO's frames, when each arrived here, and when the drive sent it by its own clock: the frame's time stamp
+    (the CAN adapter's; the simulator's virtual instant) less the frame's time on the wire at ``bitrate``."""
 
     instants: list[float] = field(default_factory=list)
+    stamps: list[float] = field(default_factory=list)
+    bitrate: int = 1_000_000
+    clock: DriveClock = field(default_factory=DriveClock)
 
     def on_frame(self, cob_id: int, data: bytes, timestamp: float) -> None:
         if len(data) == self.layout.size:
-            self.instants.append(time.monotonic())
+            arrived = time.monotonic()
+            stamp = timestamp - frame_bits(len(data)) / self.bitrate
+            self.instants.append(arrived)
+            self.stamps.append(stamp)
+            self.clock.answered(stamp, arrived)
             self.frames.append(bytes(data))
 
 
@@ -112,7 +121,10 @@ class ResponseStream(TpdoStream):
     def __init__(self, plan: ResponsePlan, drive: Drive, link: BusLink) -> None:
         super().__init__(plan.stream, lambda node: drive, link)
         self.names = plan.names
-        self.timed = [_Timed(receiver.use, receiver.layout) for receiver in self.receivers]
+        #: the drive's time, from its answers' stamps (the excitation of a drive whose cycle free-runs follows it)
+        self.clock = DriveClock()
+        self.timed = [_Timed(receiver.use, receiver.layout, bitrate=plan.bitrate, clock=self.clock)
+                      for receiver in self.receivers]  # fmt: skip
         self.receivers = [*self.timed]
 
     def _announce_cycle(self) -> None:
@@ -124,6 +136,7 @@ class ResponseStream(TpdoStream):
         self._configure()
         for receiver in self.timed:
             del receiver.instants[: len(receiver.instants) - len(receiver.frames)]
+            del receiver.stamps[: len(receiver.stamps) - len(receiver.frames)]
 
     def stalled(self, first: int, last: int, longest_s: float) -> bool:
         """Did the answers to two of SYNCs ``first`` … ``last`` arrive more than ``longest_s`` apart (a drive or bus
@@ -149,6 +162,11 @@ class ResponseStream(TpdoStream):
     def columns(self, first: int, count: int) -> list[list[float]]:
         """Samples ``first`` … ``first + count − 1``, one column per response object."""
         return [list(map(float, column)) for column in self._columns(first, first + count)]
+
+    def sync_instants(self, first: int, count: int) -> list[float]:
+        """When the drive took SYNCs ``first`` … ``first + count − 1`` by its own clock: the earliest of its answers'
+        start of transmission (the first TPDO leaves as the SYNC ends)."""
+        return [min(receiver.stamps[k] for receiver in self.timed) for k in range(first, first + count)]
 
     def close(self) -> str | None:
         """The TPDOs written back and unsubscribed (each tried); what failed, or None."""
