@@ -53,6 +53,8 @@ export class App {
   readonly projectsReady: Promise<void>;
   private resolveProjects: () => void = () => undefined;
   private projectsKnown = false;
+  /** Counts the changes `updateProject` made, so a list fetched across one is fetched again. */
+  private projectChanges = 0;
   private page: Page | null = null;
   private readonly content: State<Child> = state<Child>(null);
   private readonly crumbs: State<Child> = state<Child>(null);
@@ -186,8 +188,7 @@ export class App {
   /** Reload the projects shown in the tree (after create, rename, add axis…). */
   async refreshProjects(): Promise<void> {
     try {
-      const summaries = await projects.list();
-      this.projects.val = await Promise.all(summaries.map((summary) => projects.get(summary.name)));
+      this.projects.val = await this.fetchProjects();
       this.projectsError.val = null;
     } catch (error) {
       this.projects.val = [];
@@ -199,12 +200,24 @@ export class App {
     if (this.projectsError.rawVal === null) this.live.watchAxes(this.projects.rawVal.flatMap((project) => project.axes));
   }
 
+  /** Every project, whole; fetched again when a change was made meanwhile: a project created while the page's first
+   * list was on its way (a slow server) must not vanish from the tree when that list arrives. */
+  private async fetchProjects(): Promise<Project[]> {
+    for (;;) {
+      const changes = this.projectChanges;
+      const summaries = await projects.list();
+      const list = await Promise.all(summaries.map((summary) => projects.get(summary.name)));
+      if (changes === this.projectChanges) return list;
+    }
+  }
+
   projectsLoaded(): Project[] {
     return this.projects.rawVal;
   }
 
   /** Update one project in the tree from an API answer, so the tree never lags behind a change. */
   updateProject(project: Project): void {
+    this.projectChanges += 1;
     const list = this.projects.rawVal;
     const known = list.some((p) => p.name === project.name);
     this.projects.val = known ? list.map((p) => (p.name === project.name ? project : p)) : [...list, project];

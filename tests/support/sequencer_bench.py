@@ -29,6 +29,8 @@ from servostudio.sim.plant import Plant
 XTRAPULSPAC_EDS = str(Path(BUILTIN_EDS_DIR) / "xtrapulspac.eds")
 NODE_ID = 1
 REV = 4096  # user units per motor revolution (0x6093 at its default)
+AFTER_END = 8
+"""Control periods (2 ms) of rows `wait_program_end` waits for after a program's end."""
 WAIT = 10.0  # s of wall clock for any wait (a loaded host slows virtual time down)
 SEQUENCE_MODE = -3
 CW_ENABLE_OPERATION = 0x0F
@@ -174,11 +176,17 @@ class Bench:
         self.write(0x6040, CW_ENABLE_OPERATION | CW_STOP)
 
     def wait_program_end(self, mark: int, timeout: float = WAIT) -> list[Row]:
-        """The probe's rows from `mark` until no program runs any more (0x3601,2 back to −1 after a start)."""
+        """The probe's rows from `mark` until no program runs any more (0x3601,2 back to −1 after a start), and
+        `AFTER_END` control periods more: what the drive publishes after the end (its status word every 1 ms) is
+        in the rows, however late this thread looked."""
 
         def ended() -> bool:
             numbers = [row[EXECUTED] for row in self.rows(mark)]
-            return any(number >= 0 for number in numbers) and numbers[-1] == -1
+            started = next((n for n, number in enumerate(numbers) if number >= 0), None)
+            if started is None or numbers[-1] != -1:
+                return False
+            end = next(n for n in range(started, len(numbers)) if numbers[n] == -1)
+            return len(numbers) > end + AFTER_END
 
         wait_for(lambda: int(ended()), bool, "the end of the program", timeout)
         return self.rows(mark)

@@ -125,6 +125,13 @@ describe("the motion kept when answers and events cross", () => {
     expect(laterMotion(read, next)).toBe(next);
     expect(laterMotion(read, null)).toBeNull();
   });
+
+  it("keeps an ended motion when a stop that found nothing running answers after its event", () => {
+    const nothingRunning = { motion: null, bus: "sim", node: 2, state: "stopped" as const, reason: "stopped by local" };
+    expect(laterMotion(done, nothingRunning)).toBe(done);
+    expect(laterMotion(running, nothingRunning)).toBe(nothingRunning);
+    expect(laterMotion(null, nothingRunning)).toBe(nothingRunning);
+  });
 });
 
 describe("the homing method shown and started", () => {

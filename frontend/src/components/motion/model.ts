@@ -114,9 +114,11 @@ export class QuickMotion {
 /**
  * What the status line keeps when news of a motion arrives. An HTTP answer can come after the event of a later
  * change (a homing over before the request that started it was answered, on a loaded host): a motion never goes
- * back from ended to running, nor loses the position its end was read with.
+ * back from ended to running, nor loses the position its end was read with. A stop that found nothing running
+ * (no motion in its answer: the motion had just ended) does not hide how that motion ended.
  */
 export function laterMotion(shown: Motion | null, news: Motion | null): Motion | null {
+  if (shown?.motion && news && !news.motion && ENDED.has(shown.state)) return shown;
   if (!shown?.motion || !news?.motion || shown.motion !== news.motion) return news;
   return progress(news) >= progress(shown) ? news : shown;
 }
