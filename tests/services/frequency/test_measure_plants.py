@@ -15,6 +15,8 @@ from dataclasses import replace
 import pytest
 from tests.support.plant_truth import TWO_PI, plant_error, step_bandwidth
 
+from servostudio.services.frequency import measure
+from servostudio.services.frequency.stream import ExcitationStream
 from servostudio.sim.plant import Plant
 
 
@@ -86,3 +88,24 @@ def test_leaving_the_position_window_quick_stops_and_aborts(frequency_bench):
     status = int(bench.drive().read("statusword").raw)
     assert status & 0x6F != 0x27  # not left enabled
     assert bench.drive().read((0x1603, 0)).raw == mapping_before  # the borrowed RPDO is back
+
+
+def test_a_recording_during_which_the_syncs_stalled_is_taken_again(frequency_bench, monkeypatch):
+    """A host that held the SYNCs back (here: the stream says so of the first recording) costs a recording, not the
+    result: a drive locked to the SYNC loses it, and that recording's excitation is not periodic."""
+    plant = Plant.from_seed(3)
+    bench = frequency_bench(plant)
+    recordings, stalls = [], iter([True])
+    real_recording = measure._recording
+
+    def counted(*args):
+        recordings.append(real_recording(*args))
+        return recordings[-1]
+
+    monkeypatch.setattr(measure, "_recording", counted)
+    monkeypatch.setattr(ExcitationStream, "stalled", lambda self, first, last, longest: next(stalls, False))
+    result = bench.measure(loop="plant", amplitude_pct=100, base_speed_rad_s=15, periods=2, position_window=40)
+    assert result["aborted"] is None and result["excitation"]["periods"] == 2
+    assert len(recordings) == 2  # the first one thrown away
+    errors = [plant_error(point, plant) for point in result["points"] if 4.9 <= point["freq_hz"] <= 200.0]
+    assert max(abs(db) for db, _ in errors) < 1.5, errors

@@ -349,7 +349,7 @@ def _collect(drive: Drive, request: MeasureRequest, signal: Multisine, axis: Axi
     in_torque = axis.torque_constant is not None
     if response is None:
         _pause(watch, SETTLE_S + signal.period_s)
-        captures = _record(drive, request, signal, watch, report)
+        captures = _record(drive, request, signal, watch, report, stream)
         periods = sum(len(c.columns[0]) // _block(signal) for c in captures)
         return Collected("recorder", periods, lambda: _estimate(request, signal, axis, captures), in_torque)
     if not _follows_sync(drive):
@@ -578,8 +578,11 @@ def _channels(request: MeasureRequest) -> tuple[str, ...]:
     return ("target_velocity", "position_actual")
 
 
-def _record(drive: Drive, request: MeasureRequest, signal: Multisine, watch: Watch, report: Report) -> list[Capture]:
-    """Recordings of whole periods until ``request.periods`` are there (or the watch stops the axis)."""
+def _record(drive: Drive, request: MeasureRequest, signal: Multisine, watch: Watch, report: Report,
+            stream: ExcitationStream) -> list[Capture]:  # fmt: skip
+    """Recordings of whole periods until ``request.periods`` are there (or the watch stops the axis); a recording
+    during which the SYNCs stalled is taken again, as a TPDO period is (``_follow``), up to ``request.periods``
+    times: a drive locked to the SYNC loses it, and its excitation is no longer periodic."""
     block = _block(signal)
     definition = CaptureDefinition(
         channels=_channels(request), period_us=RECORD_PERIOD_US, samples=2, timeout_s=RECORDING_TIMEOUT_S
@@ -589,6 +592,7 @@ def _record(drive: Drive, request: MeasureRequest, signal: Multisine, watch: Wat
     session = session_of(drive)
     identity = DriveIdentity(bus="", node=drive.node, device=drive.profile.device)
     captures: list[Capture] = []
+    retakes = request.periods
     while sum(len(c.columns[0]) // block for c in captures) < request.periods and watch.reason is None:
         plan = check(
             drive,
@@ -601,10 +605,16 @@ def _record(drive: Drive, request: MeasureRequest, signal: Multisine, watch: Wat
         )
         assert isinstance(plan, CapturePlan)
         session.configure(plan)
+        first = stream.sent
         try:
-            captures.append(_recording(session, plan, identity, watch.halt))
+            capture = _recording(session, plan, identity, watch.halt)
         except Cancelled:
             break
+        if retakes > 0 and stream.stalled(first - RELOCK_SYNCS, stream.sent, STALL_S):
+            log.info("node %s: frequency response: SYNCs stalled during a recording, taking another", drive.node)
+            retakes -= 1
+            continue
+        captures.append(capture)
         done = sum(len(c.columns[0]) // block for c in captures)
         report({"stage": "recording", "fraction": round(0.1 + 0.8 * min(done / request.periods, 1.0), 3)})
     return captures

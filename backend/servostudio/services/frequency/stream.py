@@ -68,6 +68,11 @@ class ExcitationStream:
     def error(self) -> str | None:
         return self.producer.error if self.producer is not None else None
 
+    @property
+    def sent(self) -> int:
+        """SYNCs sent so far."""
+        return self.producer.count if self.producer is not None else 0
+
     def stalled(self, first: int, last: int, longest_s: float) -> bool:
         """Did any two of SYNCs ``first`` … ``last`` leave more than ``longest_s`` apart (a drive locked to the SYNC
         loses it; the simulator runs free again)?"""
