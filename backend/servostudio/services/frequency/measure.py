@@ -314,9 +314,7 @@ def measure(
     collected = Collected(source)
     try:
         _prepare(drive, request, saved, axis, source)
-        values = _values(request, signal, axis, source, gains)
-        if response is not None and not _follows_sync(drive):
-            values = _values_in_time(request, signal, axis, gains, response)
+        values = _values(request, signal, axis, source, gains, _waveform(drive, signal, response))
         watch = Watch(drive, limits, quick_stop, controlled, cancellation, _watched(drive, response)).start()
         stream.open(operational)
         if response is not None:
@@ -530,25 +528,23 @@ def _high(drive: Drive, name: str) -> int:
     return (1 << (bits - 1 if variable.data_type.is_signed else bits)) - 1
 
 
-def _values(request: MeasureRequest, signal: Multisine, axis: Axis, source: str,
-            gains: Mapping[str, Any] | None) -> Callable[[int], int]:  # fmt: skip
-    """Value k of the stream in the excited object's raw unit."""
+def _values(request: MeasureRequest, signal: Multisine, axis: Axis, source: str, gains: Mapping[str, Any] | None,
+            waveform: Callable[[int], float]) -> Callable[[int], int]:  # fmt: skip
+    """Value k of the stream in the excited object's raw unit, of ``waveform(k)`` (peak 1)."""
     if _torque_excited(request, source):
         peak = 10.0 * request.amplitude  # ‰ of the rated current
-        return lambda k: round(peak * signal.value(k))
+        return lambda k: round(peak * waveform(k))
     base = axis.speed_user(request.base_speed_rad_s)
     swing = axis.speed_user(_swing(request, axis, gains))
-    return lambda k: round(base + swing * signal.value(k))
+    return lambda k: round(base + swing * waveform(k))
 
 
-def _values_in_time(request: MeasureRequest, signal: Multisine, axis: Axis, gains: Mapping[str, Any] | None,
-                    response: ResponseStream) -> Callable[[int], int]:  # fmt: skip
-    """The value sent before each SYNC of a free-running drive: the excitation at the drive's present instant (its
-    answers' clock), so the excitation is periodic in the drive's time, not in the SYNCs' count."""
-    base = axis.speed_user(request.base_speed_rad_s)
-    swing = axis.speed_user(_swing(request, axis, gains))
-    excitation = timed.Excitation(signal)
-    return timed.values_in_time(excitation, response.clock.now, SYNC_PERIOD_S, lambda x: round(base + swing * x))
+def _waveform(drive: Drive, signal: Multisine, response: ResponseStream | None) -> Callable[[int], float]:
+    """The multi-sine's sample k for SYNC k; for a free-running drive its value at the drive's present instant (its
+    answers' clock), so the excitation is periodic in the drive's time, not in the SYNCs' count (``timed``)."""
+    if response is None or _follows_sync(drive):
+        return signal.value
+    return timed.in_time(timed.Excitation(signal), response.clock.now, SYNC_PERIOD_S)
 
 
 def _swing(request: MeasureRequest, axis: Axis, gains: Mapping[str, Any] | None) -> float:

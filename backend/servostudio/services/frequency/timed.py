@@ -233,12 +233,11 @@ def estimate_timed(loop: str, response: Timed, signal: Multisine, starts: Sequen
     return estimate.by_reference(reference, inputs, outputs, signal.frequencies_hz)
 
 
-def values_in_time(excitation: Excitation, clock: Callable[[], float | None], fallback_s: float,
-                   level: Callable[[float], int]) -> Callable[[int], int]:  # fmt: skip
-    """Value k: the excitation at the drive's present instant (before the first answer: at k·``fallback_s``)."""
+def in_time(excitation: Excitation, clock: Callable[[], float | None], fallback_s: float) -> Callable[[int], float]:
+    """Sample k: the excitation at the drive's present instant (before the first answer: at k·``fallback_s``)."""
 
-    def value(k: int) -> int:
+    def value(k: int) -> float:
         now = clock()
-        return level(excitation.at(k * fallback_s if now is None else now))
+        return excitation.at(k * fallback_s if now is None else now)
 
     return value
