@@ -7,12 +7,12 @@ the job is certainly mid-way; the job then has to report exactly which objects r
 from __future__ import annotations
 
 import threading
-import time
 from pathlib import Path
 
 import pytest
 from fastapi.testclient import TestClient
 from tests.support.access import admin_app, api_client
+from tests.support.jobs_api import finished
 
 from servostudio.api.app import Settings
 from servostudio.formats.objectfile import ObjectEntry, read_object_file, write_object_file
@@ -27,16 +27,6 @@ def app_client(tmp_path_factory):
     with api_client(app) as client:
         assert client.post("/api/buses", json={"spec": "sim"}).status_code == 201
         yield app, client
-
-
-def _finish(client: TestClient, job_id: str) -> dict:
-    deadline = time.monotonic() + WAIT
-    while time.monotonic() < deadline:
-        job = client.get(f"/api/jobs/{job_id}").json()
-        if job["state"] != "running":
-            return job
-        time.sleep(0.05)
-    raise AssertionError(f"job {job_id} still running")
 
 
 class _HoldAtFirstStep:
@@ -75,7 +65,7 @@ def _cancel_at_first_step(
         answer = client.post(f"/api/jobs/{job['id']}/cancel")
         assert answer.status_code == 200 and answer.json()["state"] == "running"
         hold.released.set()
-        return job, _finish(client, job["id"]), hold
+        return job, finished(client, job["id"], WAIT), hold
     finally:
         hold.released.set()
         hub.remove_listener(hold)
@@ -87,7 +77,7 @@ def _changed_file(app, client: TestClient, directory: Path) -> dict[tuple[int, i
     job = client.post(
         "/api/buses/sim/backup", json={"directory": str(directory), "nodes": [1], "files": ["DRIVEPAR.TXT"]}
     ).json()
-    assert _finish(client, job["id"])["state"] == "done"
+    assert finished(client, job["id"], WAIT)["state"] == "done"
     path = directory / "node1" / "DRIVEPAR.TXT"
     drive = app.state.server.connections.get("sim").drive(1)
     changed = {}
@@ -148,7 +138,7 @@ def test_cancel_of_unknown_or_finished_job(app_client, tmp_path):
     job = client.post(
         "/api/buses/sim/backup", json={"directory": str(tmp_path), "nodes": [3], "files": ["DRIVEPAR.TXT"]}
     ).json()
-    done = _finish(client, job["id"])
+    done = finished(client, job["id"], WAIT)
     assert done["state"] == "done"
     assert client.post(f"/api/jobs/{job['id']}/cancel").json()["state"] == "done"
     assert (tmp_path / "node3" / "DRIVEPAR.TXT").is_file()
@@ -164,9 +154,9 @@ def test_file_upload_as_a_job(app_client, tmp_path):
         headers={"Content-Type": "text/plain"},
     )
     assert started.status_code == 202 and started.json()["operation"] == "restore"
-    finished = _finish(client, started.json()["id"])
-    assert finished["state"] == "done"
-    (result,) = finished["result"]["1"]
+    restored = finished(client, started.json()["id"], WAIT)
+    assert restored["state"] == "done"
+    (result,) = restored["result"]["1"]
     assert result["file"] == "DRIVEPAR.TXT" and result["ok"] and result["counts"] == {"verified": len(changed)}
     drive = app.state.server.connections.get("sim").drive(1)
     assert all(drive.read(key).raw == new for key, (_, new) in changed.items())
@@ -176,5 +166,5 @@ def test_file_upload_as_a_job(app_client, tmp_path):
         content="0x6081,0=oops\n",
         headers={"Content-Type": "text/plain"},
     )
-    failed = _finish(client, broken.json()["id"])
+    failed = finished(client, broken.json()["id"], WAIT)
     assert failed["state"] == "failed" and ":1:" in failed["error"] and "nothing was written" in failed["error"]

@@ -8,6 +8,7 @@ import time
 import pytest
 from fastapi.testclient import TestClient
 from tests.support.access import admin_app, api_client
+from tests.support.jobs_api import finished
 
 from servostudio.services.scope import capture_csv
 from servostudio.services.settings import Settings
@@ -24,15 +25,6 @@ def client(tmp_path_factory, sim_opener):
     with api_client(app) as test_client:
         sim_opener(app.state.server.connections)
         yield test_client
-
-
-def finished(client: TestClient, job: dict) -> dict:
-    deadline = time.monotonic() + 60
-    while job["state"] == "running":
-        assert time.monotonic() < deadline, job
-        time.sleep(0.05)
-        job = client.get(f"/api/jobs/{job['id']}").json()
-    return job
 
 
 def wait_status(client: TestClient, wanted: str) -> dict:
@@ -61,7 +53,7 @@ def test_a_capture_job_reports_its_progress_and_keeps_the_capture(client):
     client.app.state.server.connections.events.add_listener(events.append)
     started = client.post(f"{SCOPE}/captures", json=IMMEDIATE)
     assert started.status_code == 202 and started.json()["operation"] == "scope"
-    job = finished(client, started.json())
+    job = finished(client, started.json()["id"])
     assert job["state"] == "done" and job["result"]["captures"] == 1, job
     capture_id = job["result"]["capture"]
     made = client.get(f"{SCOPE}/captures/{capture_id}").json()
@@ -118,7 +110,7 @@ def test_force_while_waiting_and_stop_of_a_normal_mode_job(client):
 def test_saved_captures_of_an_axis(client):
     assert client.post("/api/projects", json={"name": "s"}).status_code == 201
     assert client.post("/api/projects/s/scan", json={"bus": "sim"}).status_code == 200
-    capture_id = finished(client, client.post(f"{SCOPE}/captures", json=IMMEDIATE).json())["result"]["capture"]
+    capture_id = finished(client, client.post(f"{SCOPE}/captures", json=IMMEDIATE).json()["id"])["result"]["capture"]
     base = "/api/projects/s/axes/Axis1/captures"
     saved = client.post(base, json={"capture": capture_id, "name": "first"})
     assert saved.status_code == 201 and saved.json()["name"] == "first"
@@ -152,7 +144,7 @@ def test_a_drive_without_recorder_captures_through_tpdos_and_states_rate_and_bus
         assert stream["bus_load"] == pytest.approx((47 + 48 + (34 + 48 - 1) // 4 + 55) / 1000)  # 6 bytes + SYNC
         refused = client.post(f"{scope}/check", json={**definition, "period_us": 250})
         assert refused.status_code == 422 and "every 1000 µs at the fastest" in refused.json()["detail"]
-        job = finished(client, client.post(f"{scope}/captures", json=definition).json())
+        job = finished(client, client.post(f"{scope}/captures", json=definition).json()["id"])
         assert job["state"] == "done", job
         made = client.get(f"{scope}/captures/{job['result']['capture']}").json()
         assert made["source"] == "tpdo" and made["samples"] == 100 and made["alignment_ns"] is not None

@@ -68,10 +68,9 @@ def patient_hold(server):
     """The hold-to-run watchdog at 1 s instead of 0.1 s, for a test of what the motions do, not of the hold's
     timing (the killed and frozen commands below judge that): a loaded host once starved the command's keepalives
     for 200 ms and the move ended stopped — the safe side, but not what this test is about."""
-    holds = server.state.motion.motions.holds
-    holds.timeout = 1.0
+    server.set_hold_timeout(1.0)
     yield server
-    holds.timeout = HOLD_TIMEOUT
+    server.set_hold_timeout(HOLD_TIMEOUT)
 
 
 def test_moves_and_homing_through_the_server(patient_hold):

@@ -1,13 +1,14 @@
 """The REST tests' common steps of a live client (procedures, identification, frequency response, the quick test's
 motions, sequences): an axis armed over the client's event socket and released afterwards (or lost with the socket),
-the keepalives of a held motion, a condition waited for, and a job followed until it ends."""
+the keepalives of a held motion, and a job followed until it ends."""
 
 from __future__ import annotations
 
 import contextlib
 import threading
-import time
 from collections.abc import Iterator
+
+from tests.support.waits import wait_for
 
 NODE = "/api/buses/sim/nodes/1"
 
@@ -49,10 +50,12 @@ def holding(socket, bus: str, node: int) -> Iterator[None]:
 
 
 def finished(client, job: str, timeout: float = 60.0) -> dict:
-    deadline = time.monotonic() + timeout
-    while time.monotonic() < deadline:
-        state = client.get(f"/api/jobs/{job}").json()
-        if state["state"] != "running":
-            return state
-        time.sleep(0.1)
-    raise AssertionError(f"job {job} still running")
+    """The job's answer once it no longer runs."""
+    return wait_for(
+        lambda: client.get(f"/api/jobs/{job}").json(),
+        lambda state: state["state"] != "running",
+        f"job {job} ended",
+        timeout,
+        0.1,
+        lambda state: f"still {state['state']}",
+    )

@@ -70,6 +70,11 @@ class InProcessServer:
         assert isinstance(simulation, SimulatedNetwork)
         return simulation
 
+    def set_hold_timeout(self, seconds: float) -> None:
+        """The hold-to-run watchdog's timeout (0.1 s: ``HOLD_TIMEOUT``), raised by a test of what a held motion does,
+        not of the hold's timing: on a loaded host starved keepalives end it early (the safe side)."""
+        self.state.motion.motions.holds.timeout = seconds
+
     def close(self) -> None:
         self.server.should_exit = True
         self.thread.join(timeout=15)

@@ -47,7 +47,7 @@ def ttapro_ui_server(root: Path, hold_timeout: float | None = None) -> Iterator[
     with ttapro_line(NODE) as line:
         running = InProcessServer(root, buses=())
         if hold_timeout is not None:
-            running.state.motion.motions.holds.timeout = hold_timeout
+            running.set_hold_timeout(hold_timeout)
         try:
             yield _with_project(TtaProServer(running.url, line))
         finally:
